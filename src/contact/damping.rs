@@ -1,0 +1,40 @@
+//! Viscous damping of the contact, or none.
+//!
+//! [`Viscoelastic`]: `gn = -2 sqrt(5/6) beta sqrt(Sn m*)`, `gt = -2 sqrt(5/6) beta sqrt(St m*)`
+//! with `beta = ln e / sqrt(ln^2 e + pi^2)` (Tsuji's form as in LIGGGHTS `model hertz`
+//! and YADE `betan = betas = sqrt(5/6) |beta|`). The damping force is `-g v` along the
+//! relative velocity. [`Undamped`] is what a scene with e = 1 everywhere gets: no
+//! coefficients are computed at all.
+
+/// How the damping coefficients follow from the stiffnesses.
+pub trait Damping: Copy + Default + Send + Sync + 'static {
+    const NAME: &'static str;
+    /// `(gn, gt)`, kg/s, from `beta`, the tangent stiffnesses `Sn`, `St` (N/m) and `m*` (kg).
+    fn coefficients(beta: f64, sn: f64, st: f64, m_star: f64) -> (f64, f64);
+}
+
+/// sqrt(5/6).
+pub const SQRT_FIVE_SIXTHS: f64 = 0.912_870_929_175_276_9;
+
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Viscoelastic;
+
+impl Damping for Viscoelastic {
+    const NAME: &'static str = "Viscoelastic";
+    #[inline(always)]
+    fn coefficients(beta: f64, sn: f64, st: f64, m_star: f64) -> (f64, f64) {
+        let c = -2.0 * SQRT_FIVE_SIXTHS * beta;
+        (c * (sn * m_star).sqrt(), c * (st * m_star).sqrt())
+    }
+}
+
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Undamped;
+
+impl Damping for Undamped {
+    const NAME: &'static str = "Undamped";
+    #[inline(always)]
+    fn coefficients(_: f64, _: f64, _: f64, _: f64) -> (f64, f64) {
+        (0.0, 0.0)
+    }
+}

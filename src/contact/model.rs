@@ -1,0 +1,216 @@
+//! A contact model: Hertz normal force, a damping form and a tangential formulation,
+//! composed at compile time. Each named combination is one monomorphized kernel.
+
+use std::marker::PhantomData;
+
+use serde::{Deserialize, Serialize};
+
+use super::damping::{Damping, Undamped, Viscoelastic};
+use super::normal::{HertzStiffness, hertz_energy};
+use super::tangential::{Frictionless, IncrementalForce, Tangential, TangentialInput, TotalDisplacement};
+use crate::dim::Vec2;
+use crate::material::PairMaterial;
+use crate::observe::energy::EnergyLedger;
+
+/// Which distance from the grain centre the tangential force acts at (torque lever arm,
+/// and the same arm in the contact-point velocity so that work and torque agree).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum LeverArm {
+    /// The grain radius a_i = r_i (the seed).
+    #[default]
+    Radius,
+    /// r_i - dn/2 (LIGGGHTS 3.8).
+    RadiusMinusHalfOverlap,
+}
+
+impl LeverArm {
+    #[inline(always)]
+    pub fn arm(self, r: f64, dn: f64) -> f64 {
+        match self {
+            LeverArm::Radius => r,
+            LeverArm::RadiusMinusHalfOverlap => r - 0.5 * dn,
+        }
+    }
+}
+
+/// Runtime switches of a contact model that cost one predictable branch at most.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ModelOptions {
+    /// Clamp Fn >= 0 (LIGGGHTS `limitForce on`; YADE always). Default off.
+    pub limit_force: bool,
+    pub lever_arm: LeverArm,
+}
+
+/// What the kernel needs of one touching pair (or grain and wall) at one step.
+#[derive(Clone, Copy, Debug)]
+pub struct ContactInput {
+    /// Unit normal from j to i (from the wall into grain i).
+    pub n: Vec2,
+    /// Overlap dn > 0, m.
+    pub dn: f64,
+    /// Reduced radius R*, m.
+    pub r_star: f64,
+    /// Reduced mass m*, kg.
+    pub m_star: f64,
+    /// v_i - v_j at the centres, m/s.
+    pub v_rel: Vec2,
+    /// a_i w_i + a_j w_j: the spin part of the contact-point velocity, m/s.
+    pub spin: f64,
+    /// Time step, s.
+    pub dt: f64,
+}
+
+impl ContactInput {
+    /// Relative velocity of the contact points, i relative to j.
+    #[inline(always)]
+    pub fn contact_velocity(&self) -> Vec2 {
+        self.v_rel + self.spin * Vec2::new(self.n.y, -self.n.x)
+    }
+}
+
+/// The force of one contact on grain i (grain j gets the opposite).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct ContactForce {
+    /// Total force on i, N.
+    pub force: Vec2,
+    /// Tangential part of it, N (for the torques -a n x Ft).
+    pub tangential: Vec2,
+    /// Normal force Fn along n (after the clamp, if any), N.
+    pub normal: f64,
+    /// Normal stiffness kn, N/m (for diagnostics).
+    pub kn: f64,
+}
+
+/// What a contact remembers from step to step.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct ContactHistory<H> {
+    /// The tangential formulation's state.
+    pub tangential: H,
+    /// True while the contact is (or was at the previous step) touching.
+    pub active: bool,
+    /// Previous normal damping force (for the trapezoidal energy integrals), N.
+    pub fd_prev: f64,
+    /// Previous elastic tangential force, N.
+    pub fte_prev: Vec2,
+    /// Previous tangential damping force, N.
+    pub ftd_prev: Vec2,
+    /// Previous tangential elastic energy, J.
+    pub ut_prev: f64,
+}
+
+/// A contact law: the trait the stages are generic over.
+pub trait ContactLaw: Copy + Send + Sync + 'static {
+    type Damp: Damping;
+    type Tang: Tangential;
+    fn options(&self) -> ModelOptions;
+    /// One line for `explain`.
+    fn describe(&self) -> String {
+        let o = self.options();
+        format!(
+            "Contacts<Hertz, {}, {}{}{}>",
+            Self::Damp::NAME,
+            Self::Tang::NAME,
+            if o.limit_force { ", clamp Fn>=0" } else { "" },
+            if Self::Tang::FRICTION && o.lever_arm == LeverArm::RadiusMinusHalfOverlap { ", arm r-dn/2" } else { "" }
+        )
+    }
+}
+
+/// The Hertz-Mindlin contact model, composed from a damping form and a tangential
+/// formulation.
+#[derive(Clone, Copy, Debug)]
+pub struct ContactModel<Dm: Damping, T: Tangential> {
+    pub options: ModelOptions,
+    _p: PhantomData<(Dm, T)>,
+}
+
+impl<Dm: Damping, T: Tangential> ContactModel<Dm, T> {
+    pub fn new(options: ModelOptions) -> Self {
+        ContactModel { options, _p: PhantomData }
+    }
+
+    /// The force of a touching contact, updating its history; with `ENERGY`, the
+    /// trapezoidal work integrals of this step go into `ledger`.
+    #[inline(always)]
+    pub fn touch<const ENERGY: bool>(
+        &self,
+        c: &ContactInput,
+        pm: &PairMaterial,
+        h: &mut ContactHistory<T::History>,
+        ledger: &mut EnergyLedger,
+    ) -> ContactForce {
+        let st = HertzStiffness::new(pm.e_star, pm.g_star, c.r_star, c.dn);
+        let (gn, gt) = Dm::coefficients(pm.beta, st.sn, st.kt, c.m_star);
+        let vc = c.contact_velocity();
+        let vn = vc.dot(&c.n);
+        let elastic_n = st.kn * c.dn;
+        let mut fnorm = elastic_n - gn * vn;
+        if self.options.limit_force && fnorm < 0.0 {
+            fnorm = 0.0;
+        }
+        let mut force = fnorm * c.n;
+        let mut tf = Default::default();
+        if T::FRICTION {
+            let vt = vc - vn * c.n;
+            let inp = TangentialInput { n: c.n, vt, kt: st.kt, gt, cap: pm.friction * fnorm.abs(), dt: c.dt };
+            tf = T::force(&mut h.tangential, &inp);
+        }
+        let ft: Vec2 = tf.elastic + tf.damping;
+        force += ft;
+        if ENERGY {
+            let dc = vc * c.dt;
+            let fd = fnorm - elastic_n;
+            ledger.normal_damping -= 0.5 * (h.fd_prev + fd) * dc.dot(&c.n);
+            ledger.elastic_normal += hertz_energy(st.kn, c.dn);
+            if T::FRICTION {
+                let ut = if st.kt > 0.0 { 0.5 * tf.elastic.norm_squared() / st.kt } else { 0.0 };
+                ledger.tangential_damping -= 0.5 * (h.ftd_prev + tf.damping).dot(&dc);
+                let w_spring = 0.5 * (h.fte_prev + tf.elastic).dot(&dc);
+                ledger.friction += tf.slip_energy;
+                ledger.tangential_model += ut - h.ut_prev + tf.slip_energy + w_spring;
+                ledger.elastic_tangential += ut;
+                h.fte_prev = tf.elastic;
+                h.ftd_prev = tf.damping;
+                h.ut_prev = ut;
+            }
+            h.fd_prev = fd;
+        }
+        h.active = true;
+        ContactForce { force, tangential: ft, normal: fnorm, kn: st.kn }
+    }
+
+    /// A contact that was touching at the previous step and is not any more: close its
+    /// energy integrals (the force fell to zero over this step) and forget its history.
+    #[inline(always)]
+    pub fn release<const ENERGY: bool>(&self, c_velocity: Vec2, n: Vec2, dt: f64, h: &mut ContactHistory<T::History>, ledger: &mut EnergyLedger) {
+        if ENERGY {
+            let dc = c_velocity * dt;
+            ledger.normal_damping -= 0.5 * h.fd_prev * dc.dot(&n);
+            if T::FRICTION {
+                ledger.tangential_damping -= 0.5 * h.ftd_prev.dot(&dc);
+                ledger.tangential_model += -h.ut_prev + 0.5 * h.fte_prev.dot(&dc);
+            }
+        }
+        *h = ContactHistory::default();
+    }
+}
+
+impl<Dm: Damping, T: Tangential> ContactLaw for ContactModel<Dm, T> {
+    type Damp = Dm;
+    type Tang = T;
+    fn options(&self) -> ModelOptions {
+        self.options
+    }
+}
+
+/// The named combinations grainlab compiles. A scene picks one of these; any other
+/// combination is refused with this list.
+pub type HertzFrictionless = ContactModel<Viscoelastic, Frictionless>;
+pub type HertzFrictionlessElastic = ContactModel<Undamped, Frictionless>;
+/// LIGGGHTS `pair_style gran model hertz tangential history`.
+pub type LiggghtsHertzHistory = ContactModel<Viscoelastic, TotalDisplacement>;
+pub type LiggghtsHertzHistoryElastic = ContactModel<Undamped, TotalDisplacement>;
+/// YADE `Law2_ScGeom_MindlinPhys_Mindlin` (incremental tangential force).
+pub type YadeMindlin = ContactModel<Viscoelastic, IncrementalForce>;
+pub type YadeMindlinElastic = ContactModel<Undamped, IncrementalForce>;

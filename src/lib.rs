@@ -1,0 +1,51 @@
+//! # grainlab: a 2D Hertz-Mindlin DEM engine built as a validation workbench
+//!
+//! A guided tour, in the order a run goes through the code:
+//!
+//! 1. **Scene** ([`scene`]): a JSON file (or a built-in, [`scenes`]) says what is simulated:
+//!    materials ([`material`]), grains (listed, from a file, or a seeded packing, [`pack`]),
+//!    walls, periodicity, the contact model, the time step rule, outputs. It is
+//!    validated as a whole; errors name the field and the allowed range ([`error`]).
+//! 2. **Build** ([`build`]): the scene becomes a [`sim::World`] (grain state as struct of
+//!    arrays, [`particles`]; the plane and grain shapes, [`dim`]) and a **pipeline**
+//!    ([`pipeline`]) of stages, only those the scene asks for: no walls, no wall stage; no
+//!    gravity, no gravity stage; no friction, no spin. The time step follows a rule and
+//!    is checked against the stability limit ([`timestep`]).
+//! 3. **Contact physics** ([`contact`]) is composed at compile time: Hertz normal force,
+//!    a damping form, a tangential formulation (LIGGGHTS' total displacement or YADE's
+//!    increments), one monomorphized kernel per named combination. Neighbours come
+//!    from a cell list with a skin, and contact history survives rebuilds ([`neighbor`]);
+//!    x may be periodic ([`boundary`]); walls are flat or rough, fixed or loaded ([`walls`]).
+//! 4. **Simulation** ([`sim`]): velocity Verlet ([`integrate`]) runs the stages each step,
+//!    timed per stage; a watchdog stops a run that goes unstable, with a diagnosis.
+//! 5. **Observers** ([`observe`]): the energy balance, impact measurements, wall stresses,
+//!    with block-averaged confidence intervals ([`stats`]).
+//! 6. **Output** ([`output`]): `summary.json`, CSV time series with unit-suffixed headers,
+//!    ParaView `.vtp` frames with a `.pvd` index; [`run`] drives it all with a progress bar.
+//!
+//! Everything is SI: m, kg, s, N, Pa, J.
+
+pub mod boundary;
+pub mod build;
+pub mod contact;
+pub mod dim;
+pub mod error;
+pub mod integrate;
+pub mod material;
+pub mod neighbor;
+pub mod observe;
+pub mod output;
+pub mod pack;
+pub mod particles;
+pub mod pipeline;
+pub mod run;
+pub mod scene;
+pub mod scenes;
+pub mod sim;
+pub mod stats;
+pub mod timestep;
+pub mod walls;
+
+pub use build::{Built, Engine, build};
+pub use error::Error;
+pub use scene::Scene;

@@ -1,0 +1,67 @@
+//! Wall stresses of the shear cell.
+//!
+//! 2D stress convention: a wall force F (N) on a wall of length L_x becomes a stress
+//! F / (L_x t) in Pa, with t the out-of-plane depth of the scene (the disk thickness, or
+//! the mean grain diameter for spheres in the plane; `walls.thickness` overrides).
+//! Shear stress tau = (F_bottom,x - F_top,x) / (2 L_x t), normal stress
+//! sigma = (F_top,y - F_bottom,y) / (2 L_x t), both positive in a sheared, compressed cell.
+
+use serde::Serialize;
+
+use crate::build::Engine;
+use crate::dim::Vec2;
+
+/// One row of the wall time series (forces averaged over the sample interval).
+#[derive(Clone, Copy, Debug, Default, Serialize)]
+pub struct WallRow {
+    pub time_s: f64,
+    pub bottom_fx_n: f64,
+    pub bottom_fy_n: f64,
+    pub top_fx_n: f64,
+    pub top_fy_n: f64,
+    pub gap_m: f64,
+    pub shear_stress_pa: f64,
+    pub normal_stress_pa: f64,
+    pub stress_ratio: f64,
+}
+
+/// Averages the wall forces over every step of a sample interval.
+#[derive(Debug, Default)]
+pub struct WallAverager {
+    sum: [Vec2; 2],
+    n: u64,
+}
+
+impl WallAverager {
+    pub fn accumulate(&mut self, e: &dyn Engine) {
+        let w = e.walls();
+        if w.len() == 2 {
+            self.sum[0] += w[0].force;
+            self.sum[1] += w[1].force;
+            self.n += 1;
+        }
+    }
+    /// The row for the interval just finished; restarts the averages.
+    pub fn row(&mut self, e: &dyn Engine, length: f64, depth: f64) -> Option<WallRow> {
+        let w = e.walls();
+        if w.len() != 2 || self.n == 0 {
+            return None;
+        }
+        let (b, t) = (self.sum[0] / self.n as f64, self.sum[1] / self.n as f64);
+        *self = WallAverager::default();
+        let area = length * depth;
+        let tau = (b.x - t.x) / (2.0 * area);
+        let sigma = (t.y - b.y) / (2.0 * area);
+        Some(WallRow {
+            time_s: e.time(),
+            bottom_fx_n: b.x,
+            bottom_fy_n: b.y,
+            top_fx_n: t.x,
+            top_fy_n: t.y,
+            gap_m: w[1].y - w[0].y,
+            shear_stress_pa: tau,
+            normal_stress_pa: sigma,
+            stress_ratio: tau / sigma,
+        })
+    }
+}

@@ -1,0 +1,293 @@
+//! The step pipeline: the stages a scene asks for, in order, and nothing else.
+//!
+//! A scene without walls has no wall stages, without gravity no gravity stage, without
+//! friction no spin update, without periodicity no wrap; `explain` prints the list.
+
+use crate::contact::{ContactInput, ContactLaw, ContactModel};
+use crate::contact::damping::Damping;
+use crate::contact::tangential::Tangential;
+use crate::dim::{Vec2, cross};
+use crate::error::Error;
+use crate::sim::World;
+use crate::walls::{Control, Surface};
+
+/// One stage of a time step.
+pub trait Stage<L: ContactLaw>: Send {
+    fn name(&self) -> String;
+    fn run(&mut self, w: &mut World<L>) -> Result<(), Error>;
+}
+
+/// Move the walls: prescribed x velocity, and for a loaded wall the first half kick and
+/// drift in y; glued grains follow their wall.
+pub struct MoveWalls;
+
+impl<L: ContactLaw> Stage<L> for MoveWalls {
+    fn name(&self) -> String {
+        "MoveWalls".into()
+    }
+    fn run(&mut self, w: &mut World<L>) -> Result<(), Error> {
+        let dt = w.dt;
+        for wall in &mut w.walls {
+            if let Control::Load { .. } = wall.control {
+                wall.v.y += 0.5 * dt * (wall.force.y + wall.load_y()) / wall.mass;
+            }
+            let d = wall.v * dt;
+            wall.y += d.y;
+            wall.x_shift += d.x;
+            if let Surface::Rough { grains } = &wall.surface {
+                for k in grains.clone() {
+                    w.p.x[k] += d;
+                    w.p.v[k] = wall.v;
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Bring grains that left the periodic cell back in.
+pub struct PeriodicWrap;
+
+impl<L: ContactLaw> Stage<L> for PeriodicWrap {
+    fn name(&self) -> String {
+        "PeriodicX".into()
+    }
+    fn run(&mut self, w: &mut World<L>) -> Result<(), Error> {
+        let b = w.boundary;
+        for x in &mut w.p.x {
+            b.wrap(x);
+        }
+        Ok(())
+    }
+}
+
+/// Rebuild the Verlet list when a grain has moved more than half the skin.
+pub struct UpdateNeighbours;
+
+impl<L: ContactLaw> Stage<L> for UpdateNeighbours {
+    fn name(&self) -> String {
+        "Neighbours".into()
+    }
+    fn run(&mut self, w: &mut World<L>) -> Result<(), Error> {
+        if w.neighbours.needs_rebuild(&w.p.x, &w.boundary) {
+            let pairs = w.neighbours.build(&w.p.x, &w.p.r, w.p.n_free, &w.boundary);
+            w.pairs.replace(pairs);
+        }
+        Ok(())
+    }
+}
+
+/// Zero forces and torques (and start the step's stored-energy sums).
+pub struct ClearForces;
+
+impl<L: ContactLaw> Stage<L> for ClearForces {
+    fn name(&self) -> String {
+        "ClearForces".into()
+    }
+    fn run(&mut self, w: &mut World<L>) -> Result<(), Error> {
+        w.p.f.iter_mut().for_each(|f| *f = Vec2::zeros());
+        if L::Tang::FRICTION {
+            w.p.torque.iter_mut().for_each(|t| *t = 0.0);
+        }
+        w.ledger.begin_step();
+        w.max_overlap = (0.0, 0, 0);
+        Ok(())
+    }
+}
+
+/// Gravity on the free grains.
+pub struct Gravity<const ENERGY: bool>;
+
+impl<L: ContactLaw, const ENERGY: bool> Stage<L> for Gravity<ENERGY> {
+    fn name(&self) -> String {
+        "Gravity".into()
+    }
+    fn run(&mut self, w: &mut World<L>) -> Result<(), Error> {
+        let g = w.gravity;
+        for i in 0..w.p.n_free {
+            w.p.f[i] += w.p.m[i] * g;
+            if ENERGY {
+                // Constant force: the work over the step is exact with the step's displacement.
+                w.ledger.gravity += w.p.m[i] * g.dot(&w.p.v[i]) * w.dt;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Grain-grain contacts over the Verlet list.
+pub struct PairForces<const ENERGY: bool>;
+
+impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> for PairForces<ENERGY> {
+    fn name(&self) -> String {
+        "PairContacts".into()
+    }
+    fn run(&mut self, w: &mut World<ContactModel<Dm, T>>) -> Result<(), Error> {
+        let model = w.law;
+        let lever = model.options.lever_arm;
+        let dt = w.dt;
+        let p = &mut w.p;
+        let b = w.boundary;
+        let mut worst = w.max_overlap;
+        for (pair, h) in w.pairs.pairs.iter().zip(w.pairs.hist.iter_mut()) {
+            let (i, j) = (pair[0] as usize, pair[1] as usize);
+            let d = b.image(p.x[i] - p.x[j]);
+            let rsq = d.norm_squared();
+            let (ri, rj) = (p.r[i], p.r[j]);
+            let radsum = ri + rj;
+            if rsq >= radsum * radsum {
+                if h.active {
+                    let n = d / rsq.sqrt();
+                    let spin = if T::FRICTION { ri * p.omega[i] + rj * p.omega[j] } else { 0.0 };
+                    let vc = p.v[i] - p.v[j] + spin * Vec2::new(n.y, -n.x);
+                    model.release::<ENERGY>(vc, n, dt, h, &mut w.ledger);
+                }
+                continue;
+            }
+            let r = rsq.sqrt();
+            let n = d / r;
+            let dn = radsum - r;
+            let (ai, aj) = if T::FRICTION { (lever.arm(ri, dn), lever.arm(rj, dn)) } else { (0.0, 0.0) };
+            let spin = if T::FRICTION { ai * p.omega[i] + aj * p.omega[j] } else { 0.0 };
+            let (mi, mj) = (p.m[i], p.m[j]);
+            let input = ContactInput { n, dn, r_star: ri * rj / radsum, m_star: mi * mj / (mi + mj), v_rel: p.v[i] - p.v[j], spin, dt };
+            let pm = w.pair_table.get(p.material[i] as usize, p.material[j] as usize);
+            let c = model.touch::<ENERGY>(&input, pm, h, &mut w.ledger);
+            p.f[i] += c.force;
+            p.f[j] -= c.force;
+            if T::FRICTION {
+                let t = cross(n, c.tangential);
+                p.torque[i] -= ai * t;
+                p.torque[j] -= aj * t;
+            }
+            let ratio = dn / ri.min(rj);
+            if ratio > worst.0 {
+                worst = (ratio, i, j);
+            }
+        }
+        w.max_overlap = worst;
+        Ok(())
+    }
+}
+
+/// Contacts of free grains with flat walls (R* = r, m* = m).
+pub struct FlatWallForces<const ENERGY: bool>;
+
+impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> for FlatWallForces<ENERGY> {
+    fn name(&self) -> String {
+        "FlatWallContacts".into()
+    }
+    fn run(&mut self, w: &mut World<ContactModel<Dm, T>>) -> Result<(), Error> {
+        let model = w.law;
+        let lever = model.options.lever_arm;
+        let dt = w.dt;
+        let p = &mut w.p;
+        let mut worst = w.max_overlap;
+        for (k, wall) in w.walls.iter_mut().enumerate() {
+            if !wall.is_flat() {
+                continue;
+            }
+            let hist = &mut w.wall_hist[k];
+            let n = Vec2::new(0.0, wall.side);
+            let mut on_wall = Vec2::zeros();
+            for i in 0..p.n_free {
+                let h = &mut hist[i];
+                let gap = wall.side * (p.x[i].y - wall.y);
+                let ri = p.r[i];
+                if gap >= ri {
+                    if h.active {
+                        let spin = if T::FRICTION { ri * p.omega[i] } else { 0.0 };
+                        let vc = p.v[i] - wall.v + spin * Vec2::new(n.y, -n.x);
+                        model.release::<ENERGY>(vc, n, dt, h, &mut w.ledger);
+                    }
+                    continue;
+                }
+                let dn = ri - gap;
+                let ai = if T::FRICTION { lever.arm(ri, dn) } else { 0.0 };
+                let spin = if T::FRICTION { ai * p.omega[i] } else { 0.0 };
+                let input = ContactInput { n, dn, r_star: ri, m_star: p.m[i], v_rel: p.v[i] - wall.v, spin, dt };
+                let pm = w.pair_table.get(p.material[i] as usize, w.wall_material);
+                let c = model.touch::<ENERGY>(&input, pm, h, &mut w.ledger);
+                p.f[i] += c.force;
+                on_wall -= c.force;
+                if T::FRICTION {
+                    p.torque[i] -= ai * cross(n, c.tangential);
+                }
+                if dn / ri > worst.0 {
+                    worst = (dn / ri, i, usize::MAX - k);
+                }
+            }
+            wall.force = on_wall;
+        }
+        w.max_overlap = worst;
+        Ok(())
+    }
+}
+
+/// Sum the force on rough walls, account for the walls' work, and give a loaded wall
+/// its second half kick.
+pub struct FinishWalls<const ENERGY: bool>;
+
+impl<L: ContactLaw, const ENERGY: bool> Stage<L> for FinishWalls<ENERGY> {
+    fn name(&self) -> String {
+        "WallForces".into()
+    }
+    fn run(&mut self, w: &mut World<L>) -> Result<(), Error> {
+        let dt = w.dt;
+        for wall in &mut w.walls {
+            if let Surface::Rough { grains } = &wall.surface {
+                wall.force = grains.clone().map(|k| w.p.f[k]).sum();
+            }
+            if ENERGY {
+                // Work of the wall's prescribed motion on the grains over this step
+                // (trapezoid); a loaded wall's y motion is its own dynamics, and the load
+                // does the work there.
+                let d = wall.v * dt;
+                let f = 0.5 * (wall.force_prev + wall.force);
+                match wall.control {
+                    Control::Fixed => w.ledger.walls -= f.dot(&d),
+                    Control::Load { .. } => {
+                        w.ledger.walls -= f.x * d.x;
+                        w.ledger.load += wall.load_y() * d.y;
+                    }
+                }
+            }
+            wall.force_prev = wall.force;
+            if let Control::Load { .. } = wall.control {
+                wall.v.y += 0.5 * dt * (wall.force.y + wall.load_y()) / wall.mass;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Stop a run that has gone wrong, with a diagnosis.
+pub struct Watchdog {
+    /// Largest overlap allowed, as a fraction of the smaller radius.
+    pub max_overlap: f64,
+    /// Check for non-finite state every this many steps.
+    pub every: u64,
+}
+
+impl<L: ContactLaw> Stage<L> for Watchdog {
+    fn name(&self) -> String {
+        format!("Watchdog(overlap < {} r)", self.max_overlap)
+    }
+    fn run(&mut self, w: &mut World<L>) -> Result<(), Error> {
+        let (ratio, i, j) = w.max_overlap;
+        if ratio > self.max_overlap {
+            let what = if j > w.p.len() {
+                format!("grain {i} overlaps wall {} by {:.3} of its radius (bound {})", w.walls[usize::MAX - j].name, ratio, self.max_overlap)
+            } else {
+                format!("grains {i} and {j} overlap by {:.3} of the smaller radius (bound {})", ratio, self.max_overlap)
+            };
+            return Err(w.unstable(what));
+        }
+        if w.step % self.every == 0 {
+            if let Some(i) = (0..w.p.n_free).find(|&i| !(w.p.x[i].x.is_finite() && w.p.x[i].y.is_finite() && w.p.v[i].norm_squared().is_finite() && w.p.omega[i].is_finite())) {
+                return Err(w.unstable(format!("grain {i} has a non-finite position or velocity")));
+            }
+        }
+        Ok(())
+    }
+}

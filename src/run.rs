@@ -1,0 +1,251 @@
+//! Running a scene: the step loop, the observers, the outputs, the progress bar and the
+//! stage timing table.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use indicatif::{ProgressBar, ProgressStyle};
+use serde::Serialize;
+
+use crate::build::{Built, build};
+use crate::error::Error;
+use crate::observe::energy::EnergyRow;
+use crate::observe::impact::{ImpactObserver, ImpactSummary};
+use crate::observe::stress::{WallAverager, WallRow};
+use crate::output::csv::CsvSeries;
+use crate::output::vtk::VtkSeries;
+use crate::scene::{Analysis, Scene};
+use crate::stats::{Estimate, block_average};
+use crate::timestep::TimeStepInfo;
+
+#[derive(Clone, Debug, Default)]
+pub struct RunOptions {
+    /// Output directory (created); nothing is written without one.
+    pub out: Option<PathBuf>,
+    /// Show a progress bar on stderr (when it is a terminal and the run is long).
+    pub progress: bool,
+    /// Override the scene's duration, s.
+    pub duration: Option<f64>,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct StageTime {
+    pub stage: String,
+    pub seconds: f64,
+    pub share: f64,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct EnergySummary {
+    pub final_row: EnergyRow,
+    /// Largest |residual| over the run relative to the energy put in (initial energy +
+    /// the magnitudes of all work terms).
+    pub max_residual_rel: f64,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct ShearSummary {
+    /// Time from which averages are taken (second half of the run), s.
+    pub averaged_from_s: f64,
+    pub shear_stress_pa: Estimate,
+    pub normal_stress_pa: Estimate,
+    /// Effective friction tau/sigma (block averages of the ratio series).
+    pub stress_ratio: Estimate,
+    /// 2D packing fraction at the end (free grains' disk area over the gap area).
+    pub packing_fraction: f64,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct Summary {
+    pub scene: String,
+    pub status: String,
+    pub error: Option<String>,
+    pub model: String,
+    pub pipeline: String,
+    pub time_step: TimeStepInfo,
+    pub grains: usize,
+    pub steps: u64,
+    pub simulated_time_s: f64,
+    pub wall_time_s: f64,
+    pub particle_steps_per_s: f64,
+    pub energy: Option<EnergySummary>,
+    pub impact: Option<ImpactSummary>,
+    pub shear: Option<ShearSummary>,
+    pub stage_timing: Vec<StageTime>,
+}
+
+struct Outputs {
+    energy: Option<CsvSeries>,
+    walls: Option<CsvSeries>,
+    vtk: Option<VtkSeries>,
+}
+
+/// Build and run a scene.
+pub fn run_scene(scene: &Scene, opts: &RunOptions) -> Result<Summary, Error> {
+    let built = build(scene)?;
+    run_built(scene, built, opts)
+}
+
+/// Run an engine built from `scene`. On an unstable run the outputs written so far are
+/// kept, `summary.json` says what happened, and the error is returned.
+pub fn run_built(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<Summary, Error> {
+    let duration = opts.duration.unwrap_or(scene.duration);
+    let dt = built.time_step.dt_s;
+    let total = (duration / dt).ceil().max(1.0) as u64;
+    let sample_every = (total / scene.output.samples.max(1)).max(1);
+    let frame_every = if scene.output.frames > 0 { Some((total / scene.output.frames).max(1)) } else { None };
+    let energy_on = scene.output.energy;
+    let mut outputs = Outputs { energy: None, walls: None, vtk: None };
+    if let Some(dir) = &opts.out {
+        std::fs::create_dir_all(dir).map_err(|e| Error::io(dir.display(), e))?;
+        if energy_on {
+            outputs.energy = Some(CsvSeries::create(&dir.join("energy.csv"))?);
+        }
+        if !built.engine.walls().is_empty() {
+            outputs.walls = Some(CsvSeries::create(&dir.join("walls.csv"))?);
+        }
+        if frame_every.is_some() {
+            outputs.vtk = Some(VtkSeries::new(dir)?);
+        }
+    }
+    let pipeline = built.explain();
+    let e = built.engine.as_mut();
+    let mut impact = (scene.analysis == Analysis::Impact).then(ImpactObserver::default);
+    if let Some(o) = impact.as_mut() {
+        o.start(e);
+    }
+    let mut walls_avg = WallAverager::default();
+    let mut wall_rows: Vec<WallRow> = Vec::new();
+    let mut max_res: f64 = 0.0;
+    let mut energy_rows = 0usize;
+    let mut record_energy = |e: &dyn crate::build::Engine, out: &mut Outputs| -> Result<(), Error> {
+        if energy_on {
+            let row = e.energy_row();
+            max_res = max_res.max(row.residual_j.abs() / row.put_in().max(f64::MIN_POSITIVE));
+            energy_rows += 1;
+            if let Some(w) = out.energy.as_mut() {
+                w.row(&row)?;
+            }
+        }
+        Ok(())
+    };
+    record_energy(e, &mut outputs)?;
+    if let (Some(v), Some(_)) = (outputs.vtk.as_mut(), frame_every) {
+        v.frame(e)?;
+    }
+    let bar = if opts.progress {
+        let b = ProgressBar::new(total);
+        b.set_style(ProgressStyle::with_template("{msg} [{bar:40}] {percent}% {elapsed_precise} eta {eta}").expect("template").progress_chars("=> "));
+        b.set_message(scene.name.clone());
+        Some(b)
+    } else {
+        None
+    };
+    let t0 = Instant::now();
+    let mut error: Option<Error> = None;
+    for k in 1..=total {
+        if let Err(err) = e.step() {
+            error = Some(err);
+            break;
+        }
+        if let Some(o) = impact.as_mut() {
+            o.observe(e);
+        }
+        walls_avg.accumulate(e);
+        if k % sample_every == 0 || k == total {
+            record_energy(e, &mut outputs)?;
+            if let Some(row) = walls_avg.row(e, built.length, built.depth) {
+                if let Some(w) = outputs.walls.as_mut() {
+                    w.row(&row)?;
+                }
+                wall_rows.push(row);
+            }
+        }
+        if let (Some(v), Some(every)) = (outputs.vtk.as_mut(), frame_every) {
+            if k % every == 0 {
+                v.frame(e)?;
+            }
+        }
+        if k % 1000 == 0 {
+            if let Some(b) = &bar {
+                b.set_position(k);
+            }
+        }
+        if impact.as_ref().is_some_and(|o| o.finished()) {
+            record_energy(e, &mut outputs)?;
+            break;
+        }
+    }
+    let wall_time = t0.elapsed().as_secs_f64();
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
+    let timings = e.timings();
+    let total_t: f64 = timings.iter().map(|t| t.1.as_secs_f64()).sum::<f64>().max(f64::MIN_POSITIVE);
+    let stage_timing = timings.iter().map(|(s, d)| StageTime { stage: s.clone(), seconds: d.as_secs_f64(), share: d.as_secs_f64() / total_t }).collect();
+    let shear = (scene.analysis == Analysis::Shear && wall_rows.len() >= 4).then(|| shear_summary(&wall_rows, e, built.length));
+    let p = e.particles();
+    let summary = Summary {
+        scene: scene.name.clone(),
+        status: if error.is_some() { "stopped".into() } else { "completed".into() },
+        error: error.as_ref().map(|e| e.to_string()),
+        model: e.model(),
+        pipeline,
+        time_step: built.time_step,
+        grains: p.n_free,
+        steps: e.steps(),
+        simulated_time_s: e.time(),
+        wall_time_s: wall_time,
+        particle_steps_per_s: p.n_free as f64 * e.steps() as f64 / wall_time.max(1e-9),
+        energy: energy_on.then(|| EnergySummary { final_row: e.energy_row(), max_residual_rel: max_res }),
+        impact: impact.as_ref().and_then(|o| o.summary()),
+        shear,
+        stage_timing,
+    };
+    if let Some(dir) = &opts.out {
+        let path = dir.join("summary.json");
+        std::fs::write(&path, serde_json::to_string_pretty(&summary).expect("serialisable")).map_err(|e| Error::io(path.display(), e))?;
+        if let Some(o) = impact.as_ref() {
+            let mut w = CsvSeries::create(&dir.join("force_overlap.csv"))?;
+            for c in &o.curve {
+                w.row(c)?;
+            }
+        }
+    }
+    match error {
+        Some(err) => Err(err),
+        None => Ok(summary),
+    }
+}
+
+fn shear_summary(rows: &[WallRow], e: &dyn crate::build::Engine, length: f64) -> ShearSummary {
+    let half = &rows[rows.len() / 2..];
+    let col = |f: fn(&WallRow) -> f64| half.iter().map(f).collect::<Vec<f64>>();
+    let blocks = 10.min(half.len());
+    let p = e.particles();
+    let area: f64 = (0..p.n_free).map(|i| std::f64::consts::PI * p.r[i] * p.r[i]).sum();
+    let w = e.walls();
+    ShearSummary {
+        averaged_from_s: half[0].time_s,
+        shear_stress_pa: block_average(&col(|r| r.shear_stress_pa), blocks),
+        normal_stress_pa: block_average(&col(|r| r.normal_stress_pa), blocks),
+        stress_ratio: block_average(&col(|r| r.stress_ratio), blocks),
+        packing_fraction: area / (length * (w[1].y - w[0].y)),
+    }
+}
+
+/// The stage timing table as text.
+pub fn timing_table(s: &Summary) -> String {
+    let mut out = format!("{:<28} {:>10} {:>7}\n", "stage", "time (s)", "share");
+    for t in &s.stage_timing {
+        out += &format!("{:<28} {:>10.3} {:>6.1}%\n", t.stage, t.seconds, 100.0 * t.share);
+    }
+    out += &format!(
+        "{} grains x {} steps in {:.2} s: {:.2} M particle-steps/s\n",
+        s.grains,
+        s.steps,
+        s.wall_time_s,
+        s.particle_steps_per_s / 1e6
+    );
+    out
+}

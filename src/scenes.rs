@@ -1,0 +1,109 @@
+//! Built-in scenes, runnable by name: `grainlab run shear`. `grainlab scenes NAME` prints
+//! one as JSON to start a scene file from.
+
+use crate::contact::LeverArm;
+use crate::material::Material;
+use crate::pack::RadiusDist;
+use crate::scene::*;
+
+/// Names and one-line descriptions.
+pub const BUILTIN: &[(&str, &str)] = &[
+    ("collision", "two glass beads head-on at 1 m/s, e = 0.5: the seed's 1D model with energy monitoring"),
+    ("oblique", "a glass bead hitting a flat glass wall at 45 degrees and 1 m/s, e = 0.9, mu = 0.5"),
+    ("shear", "the seed's experiment: ~1000 polydisperse glass beads, periodic x, rough walls at +-0.5 m/s under 100 kPa"),
+];
+
+fn glass(restitution: f64) -> Material {
+    Material { restitution, ..Material::default() }
+}
+
+/// Two equal grains of radius `r` approaching head-on at relative speed `v`, just apart.
+pub fn head_on(material: Material, r: f64, v: f64, steps_per_contact: f64) -> Scene {
+    let gap = 1e-3 * r;
+    let m = 4.0 / 3.0 * std::f64::consts::PI * r * r * r * material.density;
+    let e_star = crate::material::PairMaterial::mix(&material, &material).e_star;
+    Scene {
+        name: "collision".into(),
+        description: BUILTIN[0].1.into(),
+        grain_shape: Default::default(),
+        materials: vec![material],
+        domain: Domain::default(),
+        grains: Grains::List(vec![
+            GrainSpec { x: [-r - gap / 2.0, 0.0], v: [v / 2.0, 0.0], omega: 0.0, r, material: 0 },
+            GrainSpec { x: [r + gap / 2.0, 0.0], v: [-v / 2.0, 0.0], omega: 0.0, r, material: 0 },
+        ]),
+        walls: None,
+        gravity: [0.0, 0.0],
+        model: ModelSpec::default(),
+        time_step: TimeStepSpec {
+            rule: TimeStepRule::StepsPerContact { steps: steps_per_contact, impact_speed: v },
+            characteristic_speed: None,
+            allow_unstable: false,
+        },
+        // The approach and three contact times (the run stops at separation anyway).
+        duration: 2.0 * gap / v + 3.0 * crate::material::hertz_contact_time(m / 2.0, r / 2.0, e_star, v),
+        neighbor: NeighborSpec::default(),
+        output: OutputSpec { samples: 200, frames: 0, energy: true },
+        analysis: Analysis::Impact,
+    }
+}
+
+/// A grain of radius `r` hitting a flat wall at `angle_deg` from the normal at speed `v`.
+pub fn oblique(material: Material, r: f64, v: f64, angle_deg: f64, tangential: TangentialSpec, steps_per_contact: f64) -> Scene {
+    let a = angle_deg.to_radians();
+    let gap = 1e-3 * r;
+    let mut s = head_on(material, r, v, steps_per_contact);
+    s.name = "oblique".into();
+    s.description = BUILTIN[1].1.into();
+    s.grains = Grains::List(vec![GrainSpec { x: [0.0, r + gap], v: [v * a.sin(), -v * a.cos()], omega: 0.0, r, material: 0 }]);
+    s.walls = Some(WallsSpec {
+        bottom: WallSpec { y: Some(0.0), velocity_x: 0.0, surface: SurfaceSpec::Flat, control: ControlSpec::Fixed, mass: None, material: 0 },
+        top: WallSpec { y: Some(1.0), velocity_x: 0.0, surface: SurfaceSpec::Flat, control: ControlSpec::Fixed, mass: None, material: 0 },
+        thickness: None,
+    });
+    s.model.tangential = tangential;
+    s
+}
+
+/// The seed's shear cell.
+pub fn shear() -> Scene {
+    let (l, v, p) = (0.04, 0.5, 1e5);
+    Scene {
+        name: "shear".into(),
+        description: BUILTIN[2].1.into(),
+        grain_shape: Default::default(),
+        materials: vec![glass(0.5)],
+        domain: Domain { periodic_x: Some([0.0, l]) },
+        grains: Grains::Pack(PackSpec {
+            count: 1000,
+            radius: RadiusDist::Uniform { min: 0.4e-3, max: 0.6e-3 },
+            seed: 1,
+            material: 0,
+            x: [0.0, l],
+            y_min: None,
+            packing_fraction: 0.8,
+        }),
+        walls: Some(WallsSpec {
+            bottom: WallSpec { y: Some(0.0), velocity_x: -v, surface: SurfaceSpec::Rough { radius: 0.5e-3 }, control: ControlSpec::Fixed, mass: None, material: 0 },
+            top: WallSpec { y: None, velocity_x: v, surface: SurfaceSpec::Rough { radius: 0.5e-3 }, control: ControlSpec::Pressure(p), mass: None, material: 0 },
+            thickness: None,
+        }),
+        gravity: [0.0, 0.0],
+        model: ModelSpec { lever_arm: LeverArm::Radius, ..ModelSpec::default() },
+        time_step: TimeStepSpec { rule: TimeStepRule::StepsPerContact { steps: 50.0, impact_speed: v }, characteristic_speed: None, allow_unstable: false },
+        duration: 0.02,
+        neighbor: NeighborSpec::default(),
+        output: OutputSpec { samples: 400, frames: 20, energy: true },
+        analysis: Analysis::Shear,
+    }
+}
+
+/// A built-in scene by name.
+pub fn builtin(name: &str) -> Option<Scene> {
+    match name {
+        "collision" => Some(head_on(glass(0.5), 1e-3, 1.0, 200.0)),
+        "oblique" => Some(oblique(glass(0.9), 1e-3, 1.0, 45.0, TangentialSpec::TotalDisplacement, 200.0)),
+        "shear" => Some(shear()),
+        _ => None,
+    }
+}

@@ -1,0 +1,106 @@
+//! Choosing the time step, and the stability limit it must respect.
+//!
+//! The reference contact for every estimate is the most demanding one a scene has: the
+//! smallest grain against another like it, and against a flat wall when there is one.
+//! - Hertz contact time at speed v: `t_c = 2.868 (m*^2 / (R* E*^2 v))^(1/5)`.
+//! - Stability of velocity Verlet: `dt < 2 / omega_max`, with `omega_n^2 = Sn / m*` and,
+//!   with friction, `omega_t^2 = kt (1/m_i + 1/m_j + a_i^2/I_i + a_j^2/I_j)`, both
+//!   stiffnesses taken at the maximum overlap of an impact at the characteristic speed.
+//! - Rayleigh time of the smallest grain: `pi r sqrt(rho/G) / (0.1631 nu + 0.8766)`.
+
+use serde::Serialize;
+
+use crate::contact::normal::HertzStiffness;
+use crate::error::{Error, check};
+use crate::material::{Material, PairMaterial, hertz_contact_time, hertz_max_overlap, rayleigh_time};
+use crate::scene::TimeStepRule;
+
+/// A reference contact: reduced radius and mass, the pair's moduli, and the inverse
+/// tangential mass of the contact point.
+#[derive(Clone, Copy, Debug)]
+pub struct RefContact {
+    pub r_star: f64,
+    pub m_star: f64,
+    pub pair: PairMaterial,
+    /// 1/m_i + 1/m_j + a_i^2/I_i + a_j^2/I_j, 1/kg.
+    pub inv_tangential_mass: f64,
+}
+
+/// The chosen time step and what it means.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct TimeStepInfo {
+    /// Time step, s.
+    pub dt_s: f64,
+    /// Hertz contact time of the reference contact at the characteristic speed, s.
+    pub contact_time_s: f64,
+    /// Steps per contact, t_c / dt.
+    pub steps_per_contact: f64,
+    /// Stability limit 2 / omega_max, s.
+    pub stability_limit_s: f64,
+    /// Rayleigh time of the smallest grain, s.
+    pub rayleigh_time_s: f64,
+    /// Speed used for t_c and the stability limit, m/s.
+    pub characteristic_speed_m_s: f64,
+}
+
+/// Contact time, stability limit over the reference contacts at speed `v`.
+fn limits(refs: &[RefContact], v: f64, friction: bool) -> (f64, f64) {
+    let mut tc = f64::INFINITY;
+    let mut omega: f64 = 0.0;
+    for c in refs {
+        tc = tc.min(hertz_contact_time(c.m_star, c.r_star, c.pair.e_star, v));
+        let dmax = hertz_max_overlap(c.m_star, c.r_star, c.pair.e_star, v);
+        let s = HertzStiffness::new(c.pair.e_star, c.pair.g_star, c.r_star, dmax);
+        omega = omega.max((s.sn / c.m_star).sqrt());
+        if friction {
+            omega = omega.max((s.kt * c.inv_tangential_mass).sqrt());
+        }
+    }
+    (tc, 2.0 / omega)
+}
+
+/// Apply the rule. `smallest` is the smallest grain's (radius, mass, material).
+pub fn choose(
+    rule: &TimeStepRule,
+    characteristic_speed: Option<f64>,
+    allow_unstable: bool,
+    refs: &[RefContact],
+    smallest: (f64, f64, &Material),
+    friction: bool,
+) -> Result<TimeStepInfo, Error> {
+    let v = characteristic_speed.unwrap_or(match rule {
+        TimeStepRule::StepsPerContact { impact_speed, .. } => *impact_speed,
+        _ => 1.0,
+    });
+    let (tc, limit) = limits(refs, v, friction);
+    let rayleigh = rayleigh_time(smallest.0, smallest.2);
+    let dt = match *rule {
+        TimeStepRule::Fixed { dt } => dt,
+        TimeStepRule::StepsPerContact { steps, impact_speed } => limits(refs, impact_speed, friction).0 / steps,
+        TimeStepRule::RayleighFraction { fraction } => fraction * rayleigh,
+        TimeStepRule::SeedRule { factor, reference_overlap } => {
+            let dn = reference_overlap * smallest.0;
+            let k_max = refs.iter().map(|c| HertzStiffness::new(c.pair.e_star, c.pair.g_star, c.r_star, dn).kn).fold(0.0, f64::max);
+            factor * 2.0 * (smallest.1 / k_max).sqrt()
+        }
+    };
+    if !allow_unstable {
+        check(
+            dt <= limit,
+            "time_step",
+            "dt",
+            format!("{dt:.4e} s"),
+            &format!(
+                "<= {limit:.4e} s, the stability limit at {v} m/s (t_c = {tc:.4e} s; use more steps per contact, or set time_step.allow_unstable)"
+            ),
+        )?;
+    }
+    Ok(TimeStepInfo {
+        dt_s: dt,
+        contact_time_s: tc,
+        steps_per_contact: tc / dt,
+        stability_limit_s: limit,
+        rayleigh_time_s: rayleigh,
+        characteristic_speed_m_s: v,
+    })
+}
