@@ -17,11 +17,16 @@ fn glass(restitution: f64) -> Material {
     Material { restitution, ..Material::default() }
 }
 
-/// Two equal grains of radius `r` approaching head-on at relative speed `v`, just apart.
+/// Two equal grains of radius `r` approaching head-on at relative speed `v`.
+///
+/// They start 10.5 time steps before contact, so that the contact begins half-way
+/// through a step at every speed and time step: the realised restitution depends on
+/// that phase at O(dt/t_c), and fixing it makes results depend on dt/t_c alone.
 pub fn head_on(material: Material, r: f64, v: f64, steps_per_contact: f64) -> Scene {
-    let gap = 1e-3 * r;
     let m = 4.0 / 3.0 * std::f64::consts::PI * r * r * r * material.density;
     let e_star = crate::material::PairMaterial::mix(&material, &material).e_star;
+    let dt = crate::material::hertz_contact_time(m / 2.0, r / 2.0, e_star, v) / steps_per_contact;
+    let gap = 10.5 * v * dt;
     Scene {
         name: "collision".into(),
         description: BUILTIN[0].1.into(),
@@ -51,8 +56,12 @@ pub fn head_on(material: Material, r: f64, v: f64, steps_per_contact: f64) -> Sc
 /// A grain of radius `r` hitting a flat wall at `angle_deg` from the normal at speed `v`.
 pub fn oblique(material: Material, r: f64, v: f64, angle_deg: f64, tangential: TangentialSpec, steps_per_contact: f64) -> Scene {
     let a = angle_deg.to_radians();
-    let gap = 1e-3 * r;
-    let mut s = head_on(material, r, v, steps_per_contact);
+    let mut s = head_on(material.clone(), r, v, steps_per_contact);
+    // 10.5 steps before contact, as for head-on impacts (grain on wall: m* = m, R* = r).
+    let m = 4.0 / 3.0 * std::f64::consts::PI * r * r * r * material.density;
+    let e_star = crate::material::PairMaterial::mix(&material, &material).e_star;
+    let dt = crate::material::hertz_contact_time(m, r, e_star, v).min(crate::material::hertz_contact_time(m / 2.0, r / 2.0, e_star, v)) / steps_per_contact;
+    let gap = 10.5 * v * a.cos() * dt;
     s.name = "oblique".into();
     s.description = BUILTIN[1].1.into();
     s.grains = Grains::List(vec![GrainSpec { x: [0.0, r + gap], v: [v * a.sin(), -v * a.cos()], omega: 0.0, r, material: 0 }]);

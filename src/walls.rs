@@ -55,7 +55,7 @@ impl Wall {
     pub fn load_y(&self) -> f64 {
         match self.control {
             Control::Fixed => 0.0,
-            Control::Load { force } => -self.side * force,
+            Control::Load { force } => self.side * force,
         }
     }
     /// Kinetic energy of the wall's own y motion (load-controlled walls), J.
