@@ -90,7 +90,7 @@ pub fn shear() -> Scene {
             material: 0,
             x: [0.0, l],
             y_min: None,
-            packing_fraction: 0.8,
+            packing_fraction: 0.75,
         }),
         walls: Some(WallsSpec {
             bottom: WallSpec { y: Some(0.0), velocity_x: -v, surface: SurfaceSpec::Rough { radius: 0.5e-3 }, control: ControlSpec::Fixed, mass: None, material: 0 },
@@ -100,7 +100,7 @@ pub fn shear() -> Scene {
         gravity: [0.0, 0.0],
         model: ModelSpec { lever_arm: LeverArm::Radius, ..ModelSpec::default() },
         time_step: TimeStepSpec { rule: TimeStepRule::StepsPerContact { steps: 50.0, impact_speed: v }, characteristic_speed: None, allow_unstable: false },
-        duration: 0.02,
+        duration: 0.05,
         neighbor: NeighborSpec::default(),
         output: OutputSpec { samples: 400, frames: 20, energy: true },
         analysis: Analysis::Shear,
