@@ -1,6 +1,7 @@
 //! Impact measurements: grain 0 against grain 1, or grain 0 against a flat wall.
 //!
-//! Watched every step. Contact start and end times are interpolated linearly between
+//! Tangential components are along `t = (n_y, -n_x)`, the normal turned clockwise: +x
+//! for a grain above a bottom wall. Watched every step. Contact start and end times are interpolated linearly between
 //! steps, and the peaks of overlap and force by a parabola through the three samples
 //! around the largest, so that the measurement error is far below one time step.
 
@@ -78,7 +79,7 @@ impl ImpactObserver {
             (n, p.r[0] - w.side * (p.x[0].y - w.y), p.v[0] - w.v, p.r[0] * p.omega[0])
         };
         let vc = vrel + spin * Vec2::new(n.y, -n.x);
-        let t = Vec2::new(-n.y, n.x);
+        let t = Vec2::new(n.y, -n.x);
         Contact { n, overlap, vn: vrel.dot(&n), vt: vc.dot(&t), force: p.f[0].dot(&n) }
     }
 
@@ -141,7 +142,7 @@ impl ImpactObserver {
     pub fn summary(&self) -> Option<ImpactSummary> {
         let (before, (after, v0, w0)) = (self.before?, self.after?);
         let n = after.n;
-        let t = Vec2::new(-n.y, n.x);
+        let t = Vec2::new(n.y, -n.x);
         Some(ImpactSummary {
             impact_speed_m_s: -before.vn,
             restitution_normal: -after.vn / before.vn,
