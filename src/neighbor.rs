@@ -212,3 +212,23 @@ pub fn cell_pairs(
     out.sort_unstable();
     out
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn history_survives_a_rebuild_and_leaves_with_its_pair() {
+        let mut list: PairList<f64> = PairList::default();
+        list.replace(vec![[0, 1], [0, 2], [3, 4]]);
+        for (k, h) in list.hist.iter_mut().enumerate() {
+            h.tangential = k as f64 + 1.0;
+            h.active = true;
+        }
+        // [0, 2] leaves, [1, 2] and [2, 3] arrive, the others stay.
+        list.replace(vec![[0, 1], [1, 2], [2, 3], [3, 4]]);
+        let kept: Vec<f64> = list.hist.iter().map(|h| h.tangential).collect();
+        assert_eq!(kept, vec![1.0, 0.0, 0.0, 3.0]);
+        assert_eq!(list.touching(), 2);
+    }
+}
