@@ -150,15 +150,16 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
             let (ai, aj) = if T::FRICTION { (lever.arm(ri, dn), lever.arm(rj, dn)) } else { (0.0, 0.0) };
             let spin = if T::FRICTION { ai * p.omega[i] + aj * p.omega[j] } else { 0.0 };
             let (mi, mj) = (p.m[i], p.m[j]);
-            let input = ContactInput { n, dn, r_star: ri * rj / radsum, m_star: mi * mj / (mi + mj), v_rel: p.v[i] - p.v[j], spin, dt };
+            let tangential_scale = if T::FRICTION { lever.translation_scale(radsum, dn) } else { 1.0 };
+            let input = ContactInput { n, dn, r_star: ri * rj / radsum, m_star: mi * mj / (mi + mj), v_rel: p.v[i] - p.v[j], spin, dt, tangential_scale };
             let pm = w.pair_table.get(p.material[i] as usize, p.material[j] as usize);
             let c = model.touch::<ENERGY>(&input, pm, h, &mut w.ledger);
             p.f[i] += c.force;
             p.f[j] -= c.force;
             if T::FRICTION {
                 let t = cross(n, c.tangential);
-                p.torque[i] -= ai * t;
-                p.torque[j] -= aj * t;
+                p.torque[i] -= lever.torque_arm(ri, dn) * t;
+                p.torque[j] -= lever.torque_arm(rj, dn) * t;
             }
             let ratio = dn / ri.min(rj);
             if ratio > worst.0 {
@@ -205,13 +206,13 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
                 let dn = ri - gap;
                 let ai = if T::FRICTION { lever.arm(ri, dn) } else { 0.0 };
                 let spin = if T::FRICTION { ai * p.omega[i] } else { 0.0 };
-                let input = ContactInput { n, dn, r_star: ri, m_star: p.m[i], v_rel: p.v[i] - wall.v, spin, dt };
+                let input = ContactInput { n, dn, r_star: ri, m_star: p.m[i], v_rel: p.v[i] - wall.v, spin, dt, tangential_scale: 1.0 };
                 let pm = w.pair_table.get(p.material[i] as usize, w.wall_material);
                 let c = model.touch::<ENERGY>(&input, pm, h, &mut w.ledger);
                 p.f[i] += c.force;
                 on_wall -= c.force;
                 if T::FRICTION {
-                    p.torque[i] -= ai * cross(n, c.tangential);
+                    p.torque[i] -= lever.wall_torque_arm(ri, dn) * cross(n, c.tangential);
                 }
                 if dn / ri > worst.0 {
                     worst = (dn / ri, i, usize::MAX - k);

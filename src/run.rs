@@ -43,7 +43,7 @@ pub struct EnergySummary {
     pub max_residual_rel: f64,
 }
 
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, serde::Deserialize)]
 pub struct ShearSummary {
     /// Time from which averages are taken (second half of the run), s.
     pub averaged_from_s: f64,
@@ -51,8 +51,9 @@ pub struct ShearSummary {
     pub normal_stress_pa: Estimate,
     /// Effective friction tau/sigma (block averages of the ratio series).
     pub stress_ratio: Estimate,
-    /// 2D packing fraction at the end (free grains' disk area over the gap area).
-    pub packing_fraction: f64,
+    /// 2D packing fraction at the end (free grains' disk area over the gap area); not
+    /// known for a reference code's wall output.
+    pub packing_fraction: Option<f64>,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -219,18 +220,24 @@ pub fn run_built(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<S
 }
 
 fn shear_summary(rows: &[WallRow], e: &dyn crate::build::Engine, length: f64) -> ShearSummary {
-    let half = &rows[rows.len() / 2..];
-    let col = |f: fn(&WallRow) -> f64| half.iter().map(f).collect::<Vec<f64>>();
-    let blocks = 10.min(half.len());
     let p = e.particles();
     let area: f64 = (0..p.n_free).map(|i| std::f64::consts::PI * p.r[i] * p.r[i]).sum();
     let w = e.walls();
+    stress_estimates(rows, Some(area / (length * (w[1].y - w[0].y))))
+}
+
+/// Time averages of the wall stresses over the second half of a wall series, in 10
+/// blocks (the same estimator for the engine and for the reference codes' output).
+pub fn stress_estimates(rows: &[WallRow], packing_fraction: Option<f64>) -> ShearSummary {
+    let half = &rows[rows.len() / 2..];
+    let col = |f: fn(&WallRow) -> f64| half.iter().map(f).collect::<Vec<f64>>();
+    let blocks = 10.min(half.len());
     ShearSummary {
         averaged_from_s: half[0].time_s,
         shear_stress_pa: block_average(&col(|r| r.shear_stress_pa), blocks),
         normal_stress_pa: block_average(&col(|r| r.normal_stress_pa), blocks),
         stress_ratio: block_average(&col(|r| r.stress_ratio), blocks),
-        packing_fraction: area / (length * (w[1].y - w[0].y)),
+        packing_fraction,
     }
 }
 

@@ -74,6 +74,26 @@ pub fn oblique(material: Material, r: f64, v: f64, angle_deg: f64, tangential: T
     s
 }
 
+/// A grain of radius `r` hitting a resting twin at speed `v`, `angle_deg` between its
+/// velocity and the line of centres at contact. It starts 10.5 steps before contact.
+pub fn oblique_pair(material: Material, r: f64, v: f64, angle_deg: f64, tangential: TangentialSpec, steps_per_contact: f64) -> Scene {
+    let a = angle_deg.to_radians();
+    let mut s = head_on(material.clone(), r, v, steps_per_contact);
+    let m = 4.0 / 3.0 * std::f64::consts::PI * r * r * r * material.density;
+    let e_star = crate::material::PairMaterial::mix(&material, &material).e_star;
+    let dt = crate::material::hertz_contact_time(m / 2.0, r / 2.0, e_star, v) / steps_per_contact;
+    // Moving down (-y) onto a grain at the origin: at contact n = (sin a, cos a).
+    let gap = 10.5 * v * dt;
+    s.name = "oblique-pair".into();
+    s.description = format!("a glass bead hitting a resting one at {angle_deg} degrees and {v} m/s");
+    s.grains = Grains::List(vec![
+        GrainSpec { x: [2.0 * r * a.sin(), 2.0 * r * a.cos() + gap], v: [0.0, -v], omega: 0.0, r, material: 0 },
+        GrainSpec { x: [0.0, 0.0], v: [0.0, 0.0], omega: 0.0, r, material: 0 },
+    ]);
+    s.model.tangential = tangential;
+    s
+}
+
 /// The seed's shear cell.
 pub fn shear() -> Scene {
     let (l, v, p) = (0.04, 0.5, 1e5);

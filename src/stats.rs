@@ -1,10 +1,10 @@
 //! Block averages and confidence intervals for time series of correlated samples.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use statrs::distribution::{ContinuousCDF, StudentsT};
 
 /// Mean with a 95% confidence interval from block averages.
-#[derive(Clone, Copy, Debug, Serialize, PartialEq)]
+#[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq)]
 pub struct Estimate {
     pub mean: f64,
     /// Half-width of the 95% confidence interval.

@@ -22,14 +22,46 @@ pub enum LeverArm {
     Radius,
     /// r_i - dn/2 (LIGGGHTS 3.8).
     RadiusMinusHalfOverlap,
+    /// YADE 2023's `ScGeom` kinematics with its granular-ratcheting correction: the
+    /// tangential contact velocity uses the full radii for the spins and scales the
+    /// translational part by `(r_i + r_j) / (r_i + r_j - dn)` (pairs); the torque arm is
+    /// r - dn/2 for pairs and r - dn for flat walls (YADE applies a wall force at the
+    /// centre projected onto the wall). Not energy-consistent by design: the work of the
+    /// tangential force and its torque differ by O(dn/r).
+    Yade,
 }
 
 impl LeverArm {
+    /// The arm of the spin in the contact-point velocity, m.
     #[inline(always)]
     pub fn arm(self, r: f64, dn: f64) -> f64 {
         match self {
-            LeverArm::Radius => r,
+            LeverArm::Radius | LeverArm::Yade => r,
             LeverArm::RadiusMinusHalfOverlap => r - 0.5 * dn,
+        }
+    }
+    /// The torque arm of a grain-grain contact, m.
+    #[inline(always)]
+    pub fn torque_arm(self, r: f64, dn: f64) -> f64 {
+        match self {
+            LeverArm::Radius => r,
+            LeverArm::RadiusMinusHalfOverlap | LeverArm::Yade => r - 0.5 * dn,
+        }
+    }
+    /// The torque arm of a grain on a flat wall, m.
+    #[inline(always)]
+    pub fn wall_torque_arm(self, r: f64, dn: f64) -> f64 {
+        match self {
+            LeverArm::Yade => r - dn,
+            _ => self.torque_arm(r, dn),
+        }
+    }
+    /// Factor on the translational part of the tangential velocity of a pair.
+    #[inline(always)]
+    pub fn translation_scale(self, radsum: f64, dn: f64) -> f64 {
+        match self {
+            LeverArm::Yade => radsum / (radsum - dn),
+            _ => 1.0,
         }
     }
 }
@@ -59,6 +91,9 @@ pub struct ContactInput {
     pub spin: f64,
     /// Time step, s.
     pub dt: f64,
+    /// Factor on the translational part of the tangential velocity (1, except for YADE's
+    /// ratcheting correction, [`LeverArm::translation_scale`]).
+    pub tangential_scale: f64,
 }
 
 impl ContactInput {
@@ -112,7 +147,11 @@ pub trait ContactLaw: Copy + Send + Sync + 'static {
             Self::Damp::NAME,
             Self::Tang::NAME,
             if o.limit_force { ", clamp Fn>=0" } else { "" },
-            if Self::Tang::FRICTION && o.lever_arm == LeverArm::RadiusMinusHalfOverlap { ", arm r-dn/2" } else { "" }
+            match (Self::Tang::FRICTION, o.lever_arm) {
+                (true, LeverArm::RadiusMinusHalfOverlap) => ", arm r-dn/2",
+                (true, LeverArm::Yade) => ", YADE ratcheting-free kinematics",
+                _ => "",
+            }
         )
     }
 }
@@ -152,7 +191,10 @@ impl<Dm: Damping, T: Tangential> ContactModel<Dm, T> {
         let mut force = fnorm * c.n;
         let mut tf = Default::default();
         if T::FRICTION {
-            let vt = vc - vn * c.n;
+            let mut vt = vc - vn * c.n;
+            if c.tangential_scale != 1.0 {
+                vt += (c.tangential_scale - 1.0) * (c.v_rel - c.v_rel.dot(&c.n) * c.n);
+            }
             let inp = TangentialInput { n: c.n, vt, kt: st.kt, gt, cap: pm.friction * fnorm.abs(), dt: c.dt };
             tf = T::force(&mut h.tangential, &inp);
         }

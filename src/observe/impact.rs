@@ -8,10 +8,10 @@
 use serde::Serialize;
 
 use crate::build::Engine;
-use crate::dim::{Vec2, cross};
+use crate::dim::Vec2;
 
 /// One sample of the force-overlap curve.
-#[derive(Clone, Copy, Debug, Serialize)]
+#[derive(Clone, Copy, Debug, Serialize, serde::Deserialize)]
 pub struct CurvePoint {
     pub time_s: f64,
     pub overlap_m: f64,
@@ -19,7 +19,7 @@ pub struct CurvePoint {
 }
 
 /// What one impact did.
-#[derive(Clone, Copy, Debug, Default, Serialize)]
+#[derive(Clone, Copy, Debug, Default, Serialize, serde::Deserialize)]
 pub struct ImpactSummary {
     /// Normal relative speed before contact, m/s (positive).
     pub impact_speed_m_s: f64,
@@ -66,42 +66,93 @@ pub struct ImpactObserver {
     max_dp: f64,
 }
 
-impl ImpactObserver {
-    fn contact(e: &dyn Engine) -> Contact {
+/// What the impact observer needs of one step: grain 0, and grain 1 or a flat wall.
+/// Built from a running engine, or from a reference code's output (`grainlab digest`),
+/// so that both are measured by the same code.
+#[derive(Clone, Copy, Debug)]
+pub struct ImpactState {
+    pub time: f64,
+    pub x: [Vec2; 2],
+    pub v: [Vec2; 2],
+    pub omega: [f64; 2],
+    pub r: [f64; 2],
+    /// Force on grain 0, N.
+    pub f0: Vec2,
+    /// Grain 0 against a flat wall `(y, side, velocity)` instead of grain 1.
+    pub wall: Option<(f64, f64, Vec2)>,
+    /// Periodicity, for the pair's separation vector.
+    pub boundary: crate::boundary::Boundary,
+    /// Total momentum of the free grains, kg m/s (two-grain impacts).
+    pub momentum: Vec2,
+    /// Sum of m |v| over the free grains, kg m/s.
+    pub momentum_scale: f64,
+}
+
+impl ImpactState {
+    /// The state of a running engine.
+    pub fn of(e: &dyn Engine) -> ImpactState {
         let p = e.particles();
-        let (n, overlap, vrel, spin) = if p.n_free >= 2 {
-            let d = e.boundary().image(p.x[0] - p.x[1]);
-            let n = d / d.norm();
-            (n, p.r[0] + p.r[1] - d.norm(), p.v[0] - p.v[1], p.r[0] * p.omega[0] + p.r[1] * p.omega[1])
-        } else {
+        let two = p.n_free >= 2;
+        let j = if two { 1 } else { 0 };
+        let wall = (!two).then(|| {
             let w = e.walls().iter().find(|w| w.is_flat()).expect("an impact scene has two grains or a flat wall");
-            let n = Vec2::new(0.0, w.side);
-            (n, p.r[0] - w.side * (p.x[0].y - w.y), p.v[0] - w.v, p.r[0] * p.omega[0])
+            (w.y, w.side, w.v)
+        });
+        ImpactState {
+            time: e.time(),
+            x: [p.x[0], p.x[j]],
+            v: [p.v[0], p.v[j]],
+            omega: [p.omega[0], p.omega[j]],
+            r: [p.r[0], p.r[j]],
+            f0: p.f[0],
+            wall,
+            boundary: e.boundary(),
+            momentum: p.momentum(),
+            momentum_scale: (0..p.n_free).map(|i| p.m[i] * p.v[i].norm()).sum::<f64>(),
+        }
+    }
+
+    fn contact(&self) -> Contact {
+        let (n, overlap, vrel, spin) = match self.wall {
+            None => {
+                let d = self.boundary.image(self.x[0] - self.x[1]);
+                let n = d / d.norm();
+                (n, self.r[0] + self.r[1] - d.norm(), self.v[0] - self.v[1], self.r[0] * self.omega[0] + self.r[1] * self.omega[1])
+            }
+            Some((y, side, vw)) => {
+                let n = Vec2::new(0.0, side);
+                (n, self.r[0] - side * (self.x[0].y - y), self.v[0] - vw, self.r[0] * self.omega[0])
+            }
         };
-        let vc = vrel + spin * Vec2::new(n.y, -n.x);
         let t = Vec2::new(n.y, -n.x);
-        Contact { n, overlap, vn: vrel.dot(&n), vt: vc.dot(&t), force: p.f[0].dot(&n) }
+        let vc = vrel + spin * t;
+        Contact { n, overlap, vn: vrel.dot(&n), vt: vc.dot(&t), force: self.f0.dot(&n) }
     }
+}
 
-    fn momentum(e: &dyn Engine) -> Vec2 {
-        e.particles().momentum()
-    }
-
+impl ImpactObserver {
     /// Call once before the first step.
     pub fn start(&mut self, e: &dyn Engine) {
-        self.p0 = Self::momentum(e);
-        let p = e.particles();
-        self.p_scale = (0..p.n_free).map(|i| p.m[i] * p.v[i].norm()).sum::<f64>().max(f64::MIN_POSITIVE);
-        self.prev = Some((e.time(), Self::contact(e)));
+        self.start_state(&ImpactState::of(e));
+    }
+
+    pub fn start_state(&mut self, s: &ImpactState) {
+        self.p0 = s.momentum;
+        self.p_scale = s.momentum_scale.max(f64::MIN_POSITIVE);
+        self.prev = Some((s.time, s.contact()));
     }
 
     /// Call after every step.
     pub fn observe(&mut self, e: &dyn Engine) {
-        let t = e.time();
-        let c = Self::contact(e);
+        self.observe_state(&ImpactState::of(e));
+    }
+
+    pub fn observe_state(&mut self, s: &ImpactState) {
+        let t = s.time;
+        let c = s.contact();
         let (tp, cp) = self.prev.expect("start() was called");
-        if e.particles().n_free >= 2 {
-            self.max_dp = self.max_dp.max((Self::momentum(e) - self.p0).norm() / self.p_scale);
+        if s.wall.is_none() {
+            self.max_dp = self.max_dp.max((s.momentum - self.p0).norm() / self.p_scale);
         }
         if c.overlap > 0.0 {
             if self.t_start.is_none() {
@@ -114,11 +165,9 @@ impl ImpactObserver {
         } else if cp.overlap > 0.0 && self.t_end.is_none() {
             self.t_end = Some(tp + (t - tp) * cp.overlap / (cp.overlap - c.overlap));
         }
-        if self.t_end.is_some() {
-            let p = e.particles();
-            self.after = Some((c, p.v[0], p.omega[0]));
+        if self.t_end.is_some() && self.after.is_none() {
+            self.after = Some((c, s.v[0], s.omega[0]));
         }
-        let _ = cross;
         self.prev = Some((t, c));
     }
 

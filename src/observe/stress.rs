@@ -12,7 +12,7 @@ use crate::build::Engine;
 use crate::dim::Vec2;
 
 /// One row of the wall time series (forces averaged over the sample interval).
-#[derive(Clone, Copy, Debug, Default, Serialize)]
+#[derive(Clone, Copy, Debug, Default, Serialize, serde::Deserialize)]
 pub struct WallRow {
     pub time_s: f64,
     pub bottom_fx_n: f64,
@@ -49,19 +49,27 @@ impl WallAverager {
         }
         let (b, t) = (self.sum[0] / self.n as f64, self.sum[1] / self.n as f64);
         *self = WallAverager::default();
+        Some(WallRow::new(e.time(), b, t, w[1].y - w[0].y, length, depth))
+    }
+}
+
+impl WallRow {
+    /// A row from the forces of the grains on the bottom (`b`) and top (`t`) walls, N,
+    /// the gap, m, the cell length and depth, m.
+    pub fn new(time_s: f64, b: Vec2, t: Vec2, gap_m: f64, length: f64, depth: f64) -> WallRow {
         let area = length * depth;
         let tau = (b.x - t.x) / (2.0 * area);
         let sigma = (t.y - b.y) / (2.0 * area);
-        Some(WallRow {
-            time_s: e.time(),
+        WallRow {
+            time_s,
             bottom_fx_n: b.x,
             bottom_fy_n: b.y,
             top_fx_n: t.x,
             top_fy_n: t.y,
-            gap_m: w[1].y - w[0].y,
+            gap_m,
             shear_stress_pa: tau,
             normal_stress_pa: sigma,
             stress_ratio: tau / sigma,
-        })
+        }
     }
 }
