@@ -32,6 +32,35 @@ enum Command {
     },
     /// Print the step pipeline of a scene in one line, with dt and steps per contact.
     Explain { scene: String },
+    /// Write an equivalent LIGGGHTS deck or YADE script, the shared particle file and
+    /// export.json into a directory.
+    Export {
+        code: grainlab::export::Code,
+        scene: String,
+        #[arg(long)]
+        out: PathBuf,
+    },
+    /// Write the workbench cases (scene, case.json, decks) under a root folder.
+    Cases {
+        #[arg(long, default_value = "reference/cases")]
+        root: PathBuf,
+        /// Only cases whose name contains this.
+        #[arg(long)]
+        filter: Option<String>,
+    },
+    /// Measure a reference code's raw output (series.txt or walls.txt in RUN_DIR) into
+    /// CASE_DIR/expected/CODE/.
+    Digest { case_dir: PathBuf, code: grainlab::export::Code, run_dir: PathBuf },
+    /// Run the engine on every committed case and compare it with the reference data.
+    Compare {
+        #[arg(long, default_value = "reference/cases")]
+        root: PathBuf,
+        #[arg(long)]
+        filter: Option<String>,
+        /// Write the comparison table as CSV here.
+        #[arg(long)]
+        csv: Option<PathBuf>,
+    },
     /// List the built-in scenes, or print one as JSON.
     Scenes { name: Option<String> },
 }
@@ -73,6 +102,24 @@ fn execute(cli: Cli) -> Result<(), Error> {
             println!("{}", build(&scene)?.explain());
             Ok(())
         }
+        Command::Export { code, scene, out } => {
+            let scene = load_scene(&scene)?;
+            for path in grainlab::export::export(&scene, code, &out)? {
+                println!("{}", path.display());
+            }
+            Ok(())
+        }
+        Command::Cases { root, filter } => {
+            let n = grainlab::workbench::write_cases(&root, filter.as_deref())?;
+            eprintln!("wrote {n} cases under {}", root.display());
+            Ok(())
+        }
+        Command::Digest { case_dir, code, run_dir } => {
+            let out = grainlab::workbench::digest(&case_dir, code, &run_dir)?;
+            println!("{}", out.display());
+            Ok(())
+        }
+        Command::Compare { root, filter, csv } => compare(&root, filter.as_deref(), csv.as_deref()),
         Command::Scenes { name: None } => {
             for (n, d) in BUILTIN {
                 println!("{n:<10} {d}");
@@ -85,6 +132,44 @@ fn execute(cli: Cli) -> Result<(), Error> {
             Ok(())
         }
     }
+}
+
+fn compare(root: &std::path::Path, filter: Option<&str>, csv: Option<&std::path::Path>) -> Result<(), Error> {
+    use grainlab::workbench::{case_dirs, compare_case};
+    let mut rows = Vec::new();
+    for dir in case_dirs(root) {
+        if filter.is_some_and(|f| !dir.to_string_lossy().contains(f)) {
+            continue;
+        }
+        rows.extend(compare_case(&dir)?);
+    }
+    println!("{:<40} {:<9} {:<32} {:>14} {:>14} {:>10} {:>9} pass", "case", "code", "quantity", "engine", "reference", "diff", "bound");
+    for r in &rows {
+        let (d, kind) = if r.relative { (r.rel_diff, "rel") } else { (r.abs_diff, "abs") };
+        println!(
+            "{:<40} {:<9} {:<32} {:>14.7e} {:>14.7e} {:>10.2e} {:>5.0e} {kind} {}",
+            r.case,
+            r.code.name(),
+            r.quantity,
+            r.engine,
+            r.reference,
+            d,
+            r.tolerance,
+            if r.pass { "yes" } else { "NO" }
+        );
+    }
+    let failed = rows.iter().filter(|r| !r.pass).count();
+    eprintln!("{} comparisons, {} outside their bound", rows.len(), failed);
+    if let Some(path) = csv {
+        let mut w = grainlab::output::csv::CsvSeries::create(path)?;
+        for r in &rows {
+            w.row(r)?;
+        }
+    }
+    if failed > 0 {
+        return Err(Error::Other(format!("{failed} comparisons outside their bound")));
+    }
+    Ok(())
 }
 
 pub fn main() -> ExitCode {

@@ -23,6 +23,10 @@
 //! 6. **Output** ([`output`]): `summary.json`, CSV time series with unit-suffixed headers,
 //!    ParaView `.vtp` frames with a `.pvd` index; [`run`] drives it all with a progress bar.
 //!
+//! 7. **Export** ([`export`]): the same scene as a LIGGGHTS deck or a YADE script, for the
+//!    reference workbench ([`workbench`]: the cases under `reference/`, the reading of
+//!    the reference codes' output, the comparison) or for bigger machines.
+//!
 //! Everything is SI: m, kg, s, N, Pa, J.
 
 pub mod boundary;
@@ -30,6 +34,7 @@ pub mod build;
 pub mod contact;
 pub mod dim;
 pub mod error;
+pub mod export;
 pub mod integrate;
 pub mod material;
 pub mod neighbor;
@@ -45,6 +50,7 @@ pub mod sim;
 pub mod stats;
 pub mod timestep;
 pub mod walls;
+pub mod workbench;
 
 pub use build::{Built, Engine, build};
 pub use error::Error;

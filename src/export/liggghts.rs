@@ -1,0 +1,133 @@
+//! The LIGGGHTS 3.8 input deck of a scene.
+//!
+//! Model: `pair_style gran model hertz tangential history`, with `limitForce on` when
+//! the scene clamps Fn >= 0; flat walls are primitive `wall/gran` planes (R* = r,
+//! m* = m), rough walls are rows of atoms moved as rigid rows (`setforce` + `nve`, the
+//! top row pushed by `aveforce` for a constant load, its total mass that of the row).
+//! The traps of reference-notes.md are handled here: `hard_particles yes`, `atom_modify
+//! map array`, `communicate single vel yes`, `newton off`, `neigh_modify delay 0`,
+//! per-type material matrices that include wall types, `aveforce` per atom.
+
+use std::fmt::Write as _;
+
+use super::{Exported, f};
+use crate::contact::LeverArm;
+use crate::error::Error;
+use crate::material::PairMaterial;
+use crate::scene::{Analysis, Scene, TangentialSpec};
+use crate::walls::{Control, Surface};
+
+pub(crate) fn deck(scene: &Scene, ex: &Exported) -> Result<String, Error> {
+    let model = &scene.model;
+    let e = ex.built.engine.as_ref();
+    let p = e.particles();
+    let info = &ex.info;
+    let mats = &scene.materials;
+    let n = mats.len();
+    let mut s = String::new();
+    let w = &mut s;
+    let _ = writeln!(w, "# LIGGGHTS 3.8.0 deck exported by grainlab {} from scene `{}`. Generated: do not edit;", env!("CARGO_PKG_VERSION"), scene.name);
+    let _ = writeln!(w, "# regenerate with `grainlab export liggghts SCENE --out DIR`.");
+    let _ = writeln!(w, "# Run in this directory: liggghts -in in.liggghts (reads grains.data, writes {}).", if info.analysis == Analysis::Impact { "series.txt" } else { "walls.txt" });
+    let _ = writeln!(w, "# Grains: spheres at z = 0 in a 3D box (the sphere-in-plane model); nothing moves them out of the plane.");
+    if model.lever_arm == LeverArm::Radius && model.tangential != TangentialSpec::Frictionless {
+        let _ = writeln!(w, "# Differs: LIGGGHTS' torque lever arm is r - dn/2, the scene's is r (model.lever_arm = radius): torques differ by O(dn/r).");
+    }
+    if model.tangential == TangentialSpec::IncrementalForce {
+        let _ = writeln!(w, "# Differs: the scene's tangential model is incremental (YADE); LIGGGHTS' is total displacement. Only head-on impacts agree.");
+    }
+    if model.tangential == TangentialSpec::Frictionless {
+        let _ = writeln!(w, "# Frictionless: tangential history with coefficientFriction 0, so Ft = 0.");
+    }
+    let _ = writeln!(w, "atom_style granular\natom_modify map array");
+    let px = if e.boundary().is_periodic() { "p" } else { "f" };
+    let _ = writeln!(w, "boundary {px} f f\nnewton off\ncommunicate single vel yes\nunits si");
+    let _ = writeln!(w, "read_data grains.data");
+    let skin = scene.neighbor.skin * 2.0 * p.r[..p.n_free].iter().cloned().fold(f64::INFINITY, f64::min);
+    let _ = writeln!(w, "neighbor {} bin\nneigh_modify delay 0\nhard_particles yes", f(skin));
+    let list = |g: &dyn Fn(&crate::material::Material) -> f64| mats.iter().map(|m| f(g(m))).collect::<Vec<_>>().join(" ");
+    let _ = writeln!(w, "fix m1 all property/global youngsModulus peratomtype {}", list(&|m| m.youngs_modulus));
+    let _ = writeln!(w, "fix m2 all property/global poissonsRatio peratomtype {}", list(&|m| m.poisson_ratio));
+    let pair = |g: &dyn Fn(&PairMaterial) -> f64| {
+        let mut v = Vec::new();
+        for a in mats {
+            for b in mats {
+                let pm = PairMaterial::mix(a, b);
+                v.push(f(g(&pm)));
+            }
+        }
+        v.join(" ")
+    };
+    let _ = writeln!(w, "fix m3 all property/global coefficientRestitution peratomtypepair {n} {}", pair(&|pm| pm.restitution));
+    let frictionless = model.tangential == TangentialSpec::Frictionless;
+    let _ = writeln!(w, "fix m4 all property/global coefficientFriction peratomtypepair {n} {}", pair(&|pm| if frictionless { 0.0 } else { pm.friction }));
+    let law = format!("model hertz tangential history{}", if model.limit_force { " limitForce on" } else { "" });
+    let _ = writeln!(w, "pair_style gran {law}\npair_coeff * *");
+    let _ = writeln!(w, "timestep {}", f(info.time_step_s));
+    let _ = writeln!(w, "group free id <> 1 {}", p.n_free);
+    let _ = writeln!(w, "run 0");
+    let mut wall_vars = Vec::new();
+    for wall in e.walls() {
+        let name = wall.name;
+        match &wall.surface {
+            Surface::Flat => {
+                let shear = if wall.v.x != 0.0 { format!(" shear x {}", f(wall.v.x)) } else { String::new() };
+                let _ = writeln!(w, "fix w_{name} free wall/gran {law} primitive type {} yplane {}{shear}", ex_wall_type(scene, name), f(wall.y));
+            }
+            Surface::Rough { grains } => {
+                let (a, b) = (grains.start + 1, grains.end);
+                let _ = writeln!(w, "group {name} id <> {a} {b}");
+                match wall.control {
+                    Control::Fixed => {
+                        let _ = writeln!(w, "fix f_{name} {name} setforce 0.0 0.0 0.0");
+                        wall_vars.push((name, format!("f_f_{name}[1]"), format!("f_f_{name}[2]"), a));
+                    }
+                    Control::Load { force } => {
+                        let _ = writeln!(w, "fix f_{name} {name} setforce 0.0 NULL 0.0");
+                        let _ = writeln!(w, "# the load {} N on the row, per atom (aveforce adds its value to each atom)", f(force));
+                        let _ = writeln!(w, "fix l_{name} {name} aveforce NULL {} NULL", f(wall.load_y() / (b + 1 - a) as f64));
+                        wall_vars.push((name, format!("f_f_{name}[1]"), format!("f_l_{name}[2]"), a));
+                    }
+                }
+                let _ = writeln!(w, "fix i_{name} {name} nve");
+            }
+        }
+    }
+    let rotation = model.rotation && !frictionless;
+    let _ = writeln!(w, "fix integrate free {}", if rotation { "nve/sphere" } else { "nve" });
+    let _ = writeln!(w, "variable s equal step");
+    match info.analysis {
+        Analysis::Impact => {
+            let mut cols = vec!["${s}".to_string()];
+            for k in 1..=p.n_free {
+                for (q, v) in [("x", "x"), ("y", "y"), ("vx", "vx"), ("vy", "vy"), ("wz", "omegaz"), ("fx", "fx"), ("fy", "fy")] {
+                    let _ = writeln!(w, "variable {q}{k} equal {v}[{k}]");
+                    cols.push(format!("${{{q}{k}}}"));
+                }
+            }
+            let _ = writeln!(w, "fix rec all print 1 \"{}\" file series.txt screen no title \"{}\"", cols.join(" "), info.columns.join(" "));
+        }
+        Analysis::Shear => {
+            let k = info.sample_every;
+            let (bot, top) = (&wall_vars[0], &wall_vars[1]);
+            let _ = writeln!(w, "variable gap equal y[{}]-y[{}]", top.3, bot.3);
+            let _ = writeln!(w, "fix avg all ave/time 1 {k} {k} {} {} {} {} v_gap", bot.1, bot.2, top.1, top.2);
+            let mut cols = vec!["${s}".to_string()];
+            for j in 1..=5 {
+                let _ = writeln!(w, "variable a{j} equal f_avg[{j}]");
+                cols.push(format!("${{a{j}}}"));
+            }
+            let _ = writeln!(w, "fix rec all print {k} \"{}\" file walls.txt screen no title \"{}\"", cols.join(" "), info.columns.join(" "));
+        }
+        Analysis::None => unreachable!("checked in prepare"),
+    }
+    let _ = writeln!(w, "thermo_style custom step atoms\nthermo {}", (info.steps / 10).max(1));
+    let _ = writeln!(w, "run {}", info.steps);
+    Ok(s)
+}
+
+/// The LIGGGHTS atom type of a flat wall: its material + 1.
+fn ex_wall_type(scene: &Scene, name: &str) -> usize {
+    let w = scene.walls.as_ref().expect("a wall exists");
+    1 + if name == "bottom" { w.bottom.material } else { w.top.material }
+}

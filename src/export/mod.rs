@@ -1,0 +1,235 @@
+//! Exporting a scene to the reference codes: an equivalent LIGGGHTS 3.8 input deck and
+//! YADE 2023.02 script, never hand-kept twins.
+//!
+//! The scene is built first, so both decks start from exactly the grains grainlab starts
+//! from (a packing is generated once, here). Files written to the output directory:
+//! - `grains.data`: the shared particle file, in the LAMMPS data format because that is
+//!   the one LIGGGHTS reads (`atom-ID type diameter density x y z`, then velocities and
+//!   spins); the YADE script parses the same file;
+//! - `in.liggghts` or `yade.py`: the deck;
+//! - `export.json`: what the deck measures and how to read its output ([`ExportInfo`]).
+//!
+//! Both decks write the same raw output in the working directory: `series.txt` (impact
+//! scenes: the state of grains 1 and 2 at every step) or `walls.txt` (wall scenes: wall
+//! forces averaged over each sample interval). `scripts/regen-reference` turns that into
+//! the reference CSV schema. What each code cannot express is refused with a clear
+//! error, and every approximation is written as a comment at the top of the deck.
+
+pub mod liggghts;
+pub mod yade;
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use serde::Serialize;
+
+use crate::build::{Built, build};
+use crate::dim::GrainShape;
+use crate::error::Error;
+use crate::scene::{Analysis, Scene};
+use crate::walls::{Control, Surface};
+
+/// The reference codes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Code {
+    Liggghts,
+    Yade,
+}
+
+impl Code {
+    pub fn name(self) -> &'static str {
+        match self {
+            Code::Liggghts => "liggghts",
+            Code::Yade => "yade",
+        }
+    }
+    /// The deck's file name.
+    pub fn deck(self) -> &'static str {
+        match self {
+            Code::Liggghts => "in.liggghts",
+            Code::Yade => "yade.py",
+        }
+    }
+}
+
+/// What an exported deck measures, for the scripts that read its output.
+#[derive(Clone, Debug, Serialize, serde::Deserialize)]
+pub struct ExportInfo {
+    pub scene: String,
+    /// `impact` (writes series.txt) or `shear` (writes walls.txt).
+    pub analysis: Analysis,
+    pub time_step_s: f64,
+    pub steps: u64,
+    /// Steps per row of walls.txt.
+    pub sample_every: u64,
+    pub free_grains: usize,
+    /// Length of the periodic cell, m, and depth for stresses, m (shear scenes).
+    pub length_m: f64,
+    pub depth_m: f64,
+    /// Radii, m, and masses, kg, of the free grains (impact scenes).
+    pub radii_m: Vec<f64>,
+    pub masses_kg: Vec<f64>,
+    /// The flat wall an impact scene's grain hits: y (m), side (+1 bottom, -1 top),
+    /// x velocity (m/s).
+    pub flat_wall: Option<[f64; 3]>,
+    /// Columns of the raw output file.
+    pub columns: Vec<String>,
+}
+
+/// Number of steps a run of `scene` takes, and the sampling interval: as in `run`.
+pub fn steps_of(scene: &Scene, built: &Built) -> (u64, u64) {
+    let total = (scene.duration / built.time_step.dt_s).ceil().max(1.0) as u64;
+    (total, (total / scene.output.samples.max(1)).max(1))
+}
+
+/// Columns of series.txt for an impact scene with `two` grains (else one grain on a wall).
+pub fn impact_columns(two: bool) -> Vec<String> {
+    let mut c = vec!["step".to_string()];
+    for k in 0..if two { 2 } else { 1 } {
+        for q in ["x_m", "y_m", "vx_m_s", "vy_m_s", "omega_rad_s", "fx_n", "fy_n"] {
+            c.push(format!("{q}{k}"));
+        }
+    }
+    c
+}
+
+/// Columns of walls.txt.
+pub fn wall_columns() -> Vec<String> {
+    ["step", "bottom_fx_n", "bottom_fy_n", "top_fx_n", "top_fy_n", "gap_m"].map(String::from).to_vec()
+}
+
+/// The part of a scene both exporters need, with the checks both share.
+pub(crate) struct Exported {
+    pub built: Built,
+    pub info: ExportInfo,
+}
+
+pub(crate) fn prepare(scene: &Scene, code: Code) -> Result<Exported, Error> {
+    let unsupported = |what: &str| Err(Error::Other(format!("export to {}: {what}", code.name())));
+    if scene.grain_shape != GrainShape::SphereInPlane {
+        return unsupported("only grain_shape sphere_in_plane is exported (LIGGGHTS `dimension 2` disks are a different model)");
+    }
+    if scene.gravity != [0.0, 0.0] {
+        return unsupported("gravity is not exported yet");
+    }
+    let built = build(scene)?;
+    let (steps, sample_every) = steps_of(scene, &built);
+    let e = built.engine.as_ref();
+    let n_free = e.particles().n_free;
+    let walls = e.walls();
+    if walls.iter().any(|w| w.is_flat() && w.control != Control::Fixed) {
+        return unsupported("a flat wall under a load has no primitive-wall equivalent; use a rough wall");
+    }
+    if walls.iter().any(|w| !w.is_flat() && w.name == "bottom" && w.control != Control::Fixed) {
+        return unsupported("only the top wall may carry a load");
+    }
+    let columns = match scene.analysis {
+        Analysis::Impact => {
+            if n_free > 2 || (n_free == 1 && !walls.iter().any(|w| w.is_flat())) {
+                return unsupported("an impact scene has two grains, or one grain and a flat wall");
+            }
+            impact_columns(n_free == 2)
+        }
+        Analysis::Shear => {
+            if walls.iter().any(|w| w.is_flat()) {
+                return unsupported("the shear export needs rough walls");
+            }
+            wall_columns()
+        }
+        Analysis::None => return unsupported("only impact and shear scenes are exported (set `analysis`)"),
+    };
+    let p = e.particles();
+    let impact = scene.analysis == Analysis::Impact;
+    let info = ExportInfo {
+        radii_m: if impact { p.r[..n_free].to_vec() } else { Vec::new() },
+        masses_kg: if impact { p.m[..n_free].to_vec() } else { Vec::new() },
+        flat_wall: if impact && n_free == 1 { walls.iter().find(|w| w.is_flat()).map(|w| [w.y, w.side, w.v.x]) } else { None },
+        scene: scene.name.clone(),
+        analysis: scene.analysis,
+        time_step_s: built.time_step.dt_s,
+        steps,
+        sample_every,
+        free_grains: n_free,
+        length_m: built.length,
+        depth_m: built.depth,
+        columns,
+    };
+    Ok(Exported { built, info })
+}
+
+/// The shared particle file, LAMMPS data format for `atom_style granular`.
+pub(crate) fn grains_data(scene: &Scene, built: &Built, bounds: [[f64; 2]; 3]) -> String {
+    let p = built.engine.particles();
+    let mut s = String::new();
+    let _ = writeln!(s, "grainlab grains of scene `{}`: id type diameter(m) density(kg/m^3) x y z (m); velocities: id vx vy vz (m/s) wx wy wz (rad/s)", scene.name);
+    let _ = writeln!(s, "\n{} atoms\n{} atom types\n", p.len(), scene.materials.len());
+    for (k, ax) in ["x", "y", "z"].iter().enumerate() {
+        let _ = writeln!(s, "{:.17e} {:.17e} {ax}lo {ax}hi", bounds[k][0], bounds[k][1]);
+    }
+    let _ = writeln!(s, "\nAtoms\n");
+    for i in 0..p.len() {
+        let m = p.material[i] as usize;
+        let _ = writeln!(s, "{} {} {:.17e} {:.17e} {:.17e} {:.17e} 0", i + 1, m + 1, 2.0 * p.r[i], scene.materials[m].density, p.x[i].x, p.x[i].y);
+    }
+    let _ = writeln!(s, "\nVelocities\n");
+    for i in 0..p.len() {
+        let _ = writeln!(s, "{} {:.17e} {:.17e} 0 0 0 {:.17e}", i + 1, p.v[i].x, p.v[i].y, p.omega[i]);
+    }
+    s
+}
+
+/// Box bounds that hold every grain for the whole run: the periodic cell in x, and a
+/// margin of the distance a grain can travel at the largest initial speed.
+pub(crate) fn bounds(built: &Built, duration: f64) -> [[f64; 3]; 2] {
+    let e = built.engine.as_ref();
+    let p = e.particles();
+    let rmax = p.r.iter().cloned().fold(0.0, f64::max);
+    let vmax = p.v.iter().map(|v| v.norm()).fold(0.0, f64::max);
+    let travel = vmax * duration + 4.0 * rmax;
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for x in &p.x {
+        lo[0] = lo[0].min(x.x);
+        lo[1] = lo[1].min(x.y);
+        hi[0] = hi[0].max(x.x);
+        hi[1] = hi[1].max(x.y);
+    }
+    for w in e.walls() {
+        if w.is_flat() {
+            lo[1] = lo[1].min(w.y);
+            hi[1] = hi[1].max(w.y);
+        }
+    }
+    let gap = hi[1] - lo[1];
+    let b = e.boundary();
+    let (x0, x1) = if b.is_periodic() { (b.x_min, b.x_min + b.period) } else { (lo[0] - travel, hi[0] + travel) };
+    // A loaded wall may move: leave half the gap above.
+    let loaded = e.walls().iter().any(|w| matches!(w.control, Control::Load { .. }) && matches!(w.surface, Surface::Rough { .. }));
+    let top_margin = if loaded { 0.5 * gap } else { 0.0 };
+    [[x0, lo[1] - travel, -2.0 * rmax], [x1, hi[1] + travel + top_margin, 2.0 * rmax]]
+}
+
+/// Write the deck for `code`, the shared particle file and export.json into `dir`.
+pub fn export(scene: &Scene, code: Code, dir: &Path) -> Result<Vec<std::path::PathBuf>, Error> {
+    let ex = prepare(scene, code)?;
+    let b = bounds(&ex.built, scene.duration);
+    let deck = match code {
+        Code::Liggghts => liggghts::deck(scene, &ex)?,
+        Code::Yade => yade::deck(scene, &ex)?,
+    };
+    let data = grains_data(scene, &ex.built, [[b[0][0], b[1][0]], [b[0][1], b[1][1]], [b[0][2], b[1][2]]]);
+    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir.display(), e))?;
+    let files = [(code.deck(), deck), ("grains.data", data), ("export.json", serde_json::to_string_pretty(&ex.info).expect("serialisable") + "\n")];
+    let mut written = Vec::new();
+    for (name, text) in files {
+        let path = dir.join(name);
+        std::fs::write(&path, text).map_err(|e| Error::io(path.display(), e))?;
+        written.push(path);
+    }
+    Ok(written)
+}
+
+/// Format a float so that it reads back to the same f64.
+pub(crate) fn f(v: f64) -> String {
+    format!("{v:.17e}")
+}
