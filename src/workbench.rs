@@ -99,6 +99,12 @@ pub fn cases() -> Vec<Case> {
     s.description = "the shear cell (built-in `shear`) with LIGGGHTS' lever arm".into();
     s.output.frames = 0;
     out.push(Case { info: CaseInfo { name: "shear/liggghts".into(), description: s.description.clone(), codes: vec![Code::Liggghts], quick: false, curve: false }, scene: s });
+    let mut s = scenes::shear();
+    matched(&mut s, TangentialSpec::IncrementalForce);
+    s.name = "shear-yade".into();
+    s.description = "the shear cell (built-in `shear`) with YADE's incremental tangential force, kinematics and clamp".into();
+    s.output.frames = 0;
+    out.push(Case { info: CaseInfo { name: "shear/yade".into(), description: s.description.clone(), codes: vec![Code::Yade], quick: false, curve: false }, scene: s });
     out
 }
 

@@ -98,3 +98,38 @@ fn bad_scenes_are_refused_with_the_field_and_the_range() {
 fn an_unknown_scene_lists_the_builtins() {
     grainlab().args(["run", "no-such-scene", "--quiet"]).assert().failure().stderr(predicate::str::contains("collision, oblique, shear"));
 }
+
+#[test]
+fn export_writes_a_deck_the_particle_file_and_its_description() {
+    let dir = tempfile::tempdir().unwrap();
+    for (code, deck) in [("liggghts", "in.liggghts"), ("yade", "yade.py")] {
+        let out = dir.path().join(code);
+        grainlab().args(["export", code, "oblique", "--out", out.to_str().unwrap()]).assert().success();
+        let text = std::fs::read_to_string(out.join(deck)).unwrap();
+        assert!(text.contains("grainlab") && text.contains("grains.data"), "{deck}");
+        let data = std::fs::read_to_string(out.join("grains.data")).unwrap();
+        assert!(data.contains("1 atoms") && data.contains("Atoms") && data.contains("Velocities"));
+        let info: Value = serde_json::from_str(&std::fs::read_to_string(out.join("export.json")).unwrap()).unwrap();
+        assert_eq!(info["analysis"], "impact");
+    }
+}
+
+#[test]
+fn export_refuses_what_the_reference_code_cannot_express() {
+    // YADE's Ip2 takes one damping ratio for all pairs: two restitutions are refused, and
+    // nothing is written.
+    let mut s = builtin_json("collision");
+    let mut m2 = s["materials"][0].clone();
+    m2["restitution"] = 0.3.into();
+    s["materials"].as_array_mut().unwrap().push(m2);
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("two.json");
+    std::fs::write(&file, serde_json::to_string(&s).unwrap()).unwrap();
+    let out = dir.path().join("out");
+    grainlab()
+        .args(["export", "yade", file.to_str().unwrap(), "--out", out.to_str().unwrap()])
+        .assert()
+        .failure()
+        .stderr(predicate::str::contains("restitution"));
+    assert!(!out.exists());
+}

@@ -12,20 +12,22 @@ BETA = 2.92036985461030128e-3  # sqrt(5/6) |ln e| / sqrt(ln^2 e + pi^2)
 DT = 7.94326154077691124e-8
 STEPS = 171
 mats = [O.materials.append(FrictMat(young=E[k], poisson=NU[k], density=RHO[k], frictionAngle=math.atan(MU[k]))) for k in range(len(E))]
-ids = []
-with open('grains.data') as fh:
-    lines = [l.split() for l in fh.read().splitlines()]
-atoms = lines.index(['Atoms']) + 2
-vels = lines.index(['Velocities']) + 2
-n = int(lines[2][0])
-for k in range(n):
-    i, t, d, rho, x, y, z = lines[atoms + k]
-    b = sphere((float(x), float(y), float(z)), 0.5 * float(d), material=mats[int(t) - 1])
-    b.state.blockedDOFs = 'zXY'
-    _, vx, vy, vz, wx, wy, wz = lines[vels + k]
-    b.state.vel = Vector3(float(vx), float(vy), 0.0)
-    b.state.angVel = Vector3(0.0, 0.0, float(wz))
-    ids.append(O.bodies.append(b))
+def grains():
+    """The spheres of grains.data, in order, not yet added to the scene."""
+    with open('grains.data') as fh:
+        lines = [l.split() for l in fh.read().splitlines()]
+    atoms = lines.index(['Atoms']) + 2
+    vels = lines.index(['Velocities']) + 2
+    out = []
+    for k in range(int(lines[2][0])):
+        i, t, d, rho, x, y, z = lines[atoms + k]
+        b = sphere((float(x), float(y), float(z)), 0.5 * float(d), material=mats[int(t) - 1])
+        b.state.blockedDOFs = 'zXY'
+        _, vx, vy, vz, wx, wy, wz = lines[vels + k]
+        b.state.vel = Vector3(float(vx), float(vy), 0.0)
+        b.state.angVel = Vector3(0.0, 0.0, float(wz))
+        out.append(b)
+    return out
 O.engines = [
     ForceResetter(),
     InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Wall_Aabb()]),
@@ -38,6 +40,7 @@ O.engines = [
     NewtonIntegrator(damping=0.0),
 ]
 O.dt = DT
+ids = [O.bodies.append(b) for b in grains()]
 out = open('series.txt', 'w')
 cols = ['step']
 for k in range(len(ids)):

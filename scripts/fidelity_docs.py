@@ -1,0 +1,252 @@
+"""Write docs/fidelity.md and docs/fidelity/*.png (run through scripts/fidelity-docs)."""
+import csv, json, os, subprocess, sys, tempfile
+
+import matplotlib
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+CASES = os.path.join(ROOT, "reference", "cases")
+OUT = os.path.join(ROOT, "docs", "fidelity")
+GRAINLAB = os.path.join(ROOT, "target", "release", "grainlab")
+os.makedirs(OUT, exist_ok=True)
+TMP = tempfile.mkdtemp(prefix="grainlab-fidelity-")
+
+
+def rows(path):
+    with open(path) as f:
+        return list(csv.DictReader(f))
+
+
+def expected(case, code, name="impact.csv"):
+    p = os.path.join(CASES, case, "expected", code, name)
+    if not os.path.exists(p):
+        return None
+    return json.load(open(p)) if name.endswith(".json") else rows(p)
+
+
+def engine(case):
+    """Run the engine on a case; return its output folder."""
+    out = os.path.join(TMP, case.replace("/", "-"))
+    if not os.path.exists(os.path.join(out, "summary.json")):
+        subprocess.run([GRAINLAB, "run", os.path.join(CASES, case, "scene.json"), "--out", out, "--quiet"],
+                       check=True, capture_output=True)
+    return out
+
+
+print("comparing every case (about a minute)...", flush=True)
+cmp_csv = os.path.join(TMP, "comparison.csv")
+subprocess.run([GRAINLAB, "compare", "--csv", cmp_csv], check=True, capture_output=True)
+comparison = rows(cmp_csv)
+
+
+def group(r):
+    case = r["case"]
+    if case.startswith("restitution"):
+        return "restitution grid" + (" (clamp)" if case.endswith("clamp") else " (no clamp)")
+    return case.split("/")[0]
+
+
+# Summary table: per group, code and quantity, the largest difference and its bound.
+summary = {}
+for r in comparison:
+    key = (group(r), r["code"], r["quantity"])
+    d = float(r["rel_diff"] if r["relative"] == "true" else r["abs_diff"])
+    s = summary.setdefault(key, {"n": 0, "worst": 0.0, "bound": float(r["tolerance"]), "relative": r["relative"] == "true", "pass": True})
+    s["n"] += 1
+    s["worst"] = max(s["worst"], d)
+    s["pass"] &= r["pass"] == "true"
+    if not s["relative"]:
+        s["bound"] = max(s["bound"], float(r["tolerance"]))
+
+# Plot 1: force-overlap overlay.
+fig, axes = plt.subplots(1, 2, figsize=(10, 4))
+for ax, tag in zip(axes, ["free", "clamp"]):
+    case = f"restitution/e0.5-v1-n500-{tag}"
+    e = rows(os.path.join(engine(case), "force_overlap.csv"))
+    lig = expected(case, "liggghts", "force_overlap.csv")
+    dmax = max(float(p["overlap_m"]) for p in lig)
+    fmax = max(float(p["normal_force_n"]) for p in lig)
+    ax.plot([float(p["overlap_m"]) / dmax for p in e], [float(p["normal_force_n"]) / fmax for p in e], "-", color="k", lw=1.5, label="grainlab")
+    ax.plot([float(p["overlap_m"]) / dmax for p in lig][::12], [float(p["normal_force_n"]) / fmax for p in lig][::12], "o", mfc="none", color="C0", label="LIGGGHTS 3.8.0")
+    y = expected(case, "yade", "force_overlap.csv")
+    if y:
+        ax.plot([float(p["overlap_m"]) / dmax for p in y][6::12], [float(p["normal_force_n"]) / fmax for p in y][6::12], "x", color="C3", label="YADE 2023.02a")
+    ax.axhline(0, color="0.7", lw=0.8)
+    ax.set_title(f"e = 0.5, v = 1 m/s, dt = t_c/500, clamp {'on' if tag == 'clamp' else 'off'}")
+    ax.set_xlabel("overlap / largest overlap")
+    ax.set_ylabel("normal force / peak force")
+    ax.legend()
+fig.tight_layout()
+fig.savefig(os.path.join(OUT, "force_overlap.png"), dpi=110)
+plt.close(fig)
+
+# Plot 2: realised against input restitution.
+E = [0.1, 0.3, 0.5, 0.7, 0.9, 0.99]
+fig, axes = plt.subplots(1, 2, figsize=(10, 4))
+for ax, n in zip(axes, [50, 500]):
+    ax.plot([0, 1], [0, 1], ":", color="0.6", label="input e")
+    for tag, color in [("free", "C0"), ("clamp", "C2")]:
+        cases = [f"restitution/e{e}-v1-n{n}-{tag}" for e in E]
+        eng = [float(r["engine"]) for c in cases for r in comparison if r["case"] == c and r["code"] == "liggghts" and r["quantity"] == "restitution_normal"]
+        lig = [float(expected(c, "liggghts")[0]["restitution_normal"]) for c in cases]
+        ax.plot(E, eng, "-", color=color, label=f"grainlab, clamp {'on' if tag == 'clamp' else 'off'}")
+        ax.plot(E, lig, "o", mfc="none", color=color, label=f"LIGGGHTS, clamp {'on' if tag == 'clamp' else 'off'}")
+        if tag == "clamp":
+            ax.plot(E, [float(expected(c, "yade")[0]["restitution_normal"]) for c in cases], "x", color="C3", label="YADE (always clamps)")
+    ax.set_title(f"head-on, dt = t_c/{n} (any impact speed)")
+    ax.set_xlabel("input e")
+    ax.set_ylabel("realised e")
+    ax.legend(fontsize=8)
+fig.tight_layout()
+fig.savefig(os.path.join(OUT, "restitution.png"), dpi=110)
+plt.close(fig)
+
+# Plot 3: oblique rebound spin against angle.
+A = [5, 15, 30, 45, 60, 75, 85]
+fig, axes = plt.subplots(1, 2, figsize=(10, 4))
+for ax, target in zip(axes, ["wall", "pair"]):
+    for tag, code, color, mark in [("history", "liggghts", "C0", "o"), ("incremental", "yade", "C3", "x")]:
+        cases = [f"oblique-{target}/{tag}-a{a}" for a in A]
+        eng = [float(r["engine"]) * 1e-3 for c in cases for r in comparison if r["case"] == c and r["quantity"] == "rebound_spin_rad_s"]
+        ref = [float(expected(c, code)[0]["rebound_spin_rad_s"]) * 1e-3 for c in cases]
+        ax.plot(A, eng, "-", color=color, label=f"grainlab, {tag.replace('history', 'total displacement')}")
+        ax.plot(A, ref, mark, mfc="none", color=color, ms=8, label={"liggghts": "LIGGGHTS 3.8.0", "yade": "YADE 2023.02a"}[code])
+    ax.set_title(f"glass bead on a {'flat wall' if target == 'wall' else 'resting bead'}, 1 m/s, e = 0.9, mu = 0.5")
+    ax.set_xlabel("impact angle from the normal (deg)")
+    ax.set_ylabel("rebound spin x r / v")
+    ax.legend(fontsize=8)
+fig.tight_layout()
+fig.savefig(os.path.join(OUT, "oblique.png"), dpi=110)
+plt.close(fig)
+
+# Plot 4: shear stress time series.
+shear_cases = [(c, code) for c, code in [("shear/liggghts", "liggghts"), ("shear/yade", "yade")] if expected(c, code, "shear.json")]
+fig, axes = plt.subplots(1, len(shear_cases), figsize=(5 * len(shear_cases), 4), squeeze=False)
+shear_table = []
+for ax, (case, code) in zip(axes[0], shear_cases):
+    out = engine(case)
+    e = rows(os.path.join(out, "walls.csv"))
+    r = expected(case, code, "stress.csv")
+    ax.plot([float(x["time_s"]) * 1e3 for x in e], [float(x["stress_ratio"]) for x in e], "-", color="k", lw=0.8, label="grainlab")
+    ax.plot([float(x["time_s"]) * 1e3 for x in r], [float(x["stress_ratio"]) for x in r], "-", color="C0" if code == "liggghts" else "C3", lw=0.8, alpha=0.8,
+            label={"liggghts": "LIGGGHTS 3.8.0", "yade": "YADE 2023.02a"}[code])
+    es = json.load(open(os.path.join(out, "summary.json")))["shear"]
+    rs = expected(case, code, "shear.json")
+    for s, color in [(es, "k"), (rs, "C0" if code == "liggghts" else "C3")]:
+        m, ci = s["stress_ratio"]["mean"], s["stress_ratio"]["ci95"]
+        ax.axhspan(m - ci, m + ci, xmin=0.5, color=color, alpha=0.15)
+    ax.set_ylim(0, 0.6)
+    ax.set_title(f"{case}: tau/sigma (bands: 95% CI, second half)")
+    ax.set_xlabel("time (ms)")
+    ax.set_ylabel("tau / sigma")
+    ax.legend(fontsize=8)
+    for q in ("shear_stress_pa", "normal_stress_pa", "stress_ratio"):
+        shear_table.append((case, code, q, es[q], rs[q]))
+fig.tight_layout()
+fig.savefig(os.path.join(OUT, "shear.png"), dpi=110)
+plt.close(fig)
+
+
+def fmt(v):
+    return f"{v:.2e}" if v != 0 else "0"
+
+
+md = []
+md.append("# Fidelity: grainlab against LIGGGHTS 3.8.0 and YADE 2023.02a")
+md.append("")
+md.append("Generated by `scripts/fidelity-docs` from the committed reference data under `reference/cases`")
+md.append("(regenerated by `scripts/regen-reference`, which runs the real codes on the decks that")
+md.append("`grainlab export` writes) and from fresh engine runs. `cargo test` (tests/workbench.rs)")
+md.append("holds the engine to the same numbers and bounds.")
+md.append("")
+md.append("## Agreement, case by case")
+md.append("")
+md.append("Largest difference over each group of cases (relative, or absolute for the realised")
+md.append("restitution and for the shear stresses, whose bound is the combined 95% interval of the")
+md.append("two time averages, case by case).")
+md.append("")
+md.append("| cases | code | quantity | comparisons | largest difference | bound | all inside |")
+md.append("|---|---|---|---:|---:|---:|---|")
+for (g, code, q), s in sorted(summary.items()):
+    kind = "rel" if s["relative"] else "abs"
+    md.append(f"| {g} | {code} | {q} | {s['n']} | {fmt(s['worst'])} {kind} | {fmt(s['bound'])} | {'yes' if s['pass'] else '**no**'} |")
+md.append("")
+md.append("The bounds and why: realised restitution 1e-5 absolute, peak force and largest overlap")
+md.append("1e-4 relative, rebound spin and tangential velocity 1e-3 relative (the bounds the")
+md.append("workbench was asked to hold; the same model at the same time step reproduces the")
+md.append("reference to rounding, so each bound has orders of magnitude of room); shear stresses")
+md.append("inside the combined 95% confidence interval (a chaotic flow: only time averages can agree).")
+md.append("")
+md.append("## Force against overlap")
+md.append("")
+md.append("![force-overlap](fidelity/force_overlap.png)")
+md.append("")
+md.append("Without the clamp the force turns attractive at the end of the contact (the damping")
+md.append("force outweighs the elastic one as the overlap vanishes); LIGGGHTS does the same by")
+md.append("default. With the clamp (LIGGGHTS `limitForce on`, YADE always) it stops at zero.")
+md.append("")
+md.append("## Realised restitution")
+md.append("")
+md.append("![restitution](fidelity/restitution.png)")
+md.append("")
+md.append("All three codes agree at every grid point; all three differ from the input e, and for")
+md.append("the same reasons: (1) with the clamp the contact ends before the attractive phase, so")
+md.append("less energy is dissipated and e rises, most for small e (0.1 becomes 0.25); (2) the")
+md.append("damping force sees the half-step velocity, an error first order in dt/t_c (at t_c/50,")
+md.append("e = 0.1 realises 0.096). The four impact speeds give the same e to 6 digits at each")
+md.append("dt/t_c, as theory says for a time step scaled with the Hertz contact time.")
+md.append("")
+md.append("## Oblique impacts")
+md.append("")
+md.append("![oblique](fidelity/oblique.png)")
+md.append("")
+md.append("Each tangential formulation is compared with the code that uses it: total displacement")
+md.append("with LIGGGHTS (lever arm r - dn/2, no clamp) and incremental force with YADE (its")
+md.append("ratcheting-free kinematics, `lever_arm: \"yade\"`, and the clamp). The two formulations")
+ratios = []
+for target in ("wall", "pair"):
+    for a in A:
+        h = float(expected(f"oblique-{target}/history-a{a}", "liggghts")[0]["rebound_spin_rad_s"])
+        i = float(expected(f"oblique-{target}/incremental-a{a}", "yade")[0]["rebound_spin_rad_s"])
+        ratios.append((i / h, target, a))
+worst = max(ratios, key=lambda t: abs(t[0] - 1))
+md.append(f"differ from each other: the largest ratio of rebound spins here is {worst[0]:.2f} ({worst[1]}, {worst[2]} deg),")
+md.append("in the sticking regime at small angles, where the stored tangential force matters most;")
+md.append("that is a property of the models, not an error of either code.")
+md.append("")
+md.append("## Shear cell")
+md.append("")
+md.append("![shear](fidelity/shear.png)")
+md.append("")
+md.append("| case | code | quantity | grainlab | reference |")
+md.append("|---|---|---|---:|---:|")
+for case, code, q, e, r in shear_table:
+    md.append(f"| {case} | {code} | {q} | {e['mean']:.4g} ± {e['ci95']:.2g} | {r['mean']:.4g} ± {r['ci95']:.2g} |")
+md.append("")
+md.append("## Differences that remain, and why")
+md.append("")
+md.append("- **LIGGGHTS, every impact case**: identical to rounding (differences 1e-16 to 1e-12). The")
+md.append("  reference numbers pass through LIGGGHTS' `%.15g` output format, which bounds what can be")
+md.append("  compared at about 1e-15.")
+md.append("- **YADE, grain-grain impacts**: identical to rounding once grainlab uses YADE's contact")
+md.append("  kinematics (`lever_arm: \"yade\"`): YADE's `ScGeom` computes the tangential velocity with")
+md.append("  full radii and scales the translational part by (r1 + r2)/(r1 + r2 - dn) to avoid")
+md.append("  granular ratcheting, and applies the force at r - dn/2. With LIGGGHTS' kinematics the")
+md.append("  rebound spin would differ from YADE's by about 1e-3.")
+md.append("- **YADE, grain on a wall**: up to 2e-9 relative. YADE gives a Hertzian wall a large but")
+md.append("  finite radius, so its reduced radius R* and its ratcheting factor differ from a true")
+md.append("  plane's (grainlab's: R* = r) by O(r / R_wall). YADE also applies a wall force at the")
+md.append("  sphere centre projected onto the wall (torque arm r - dn), which grainlab reproduces in")
+md.append("  the `yade` kinematics.")
+md.append("- **YADE velocities** are leapfrog half-step velocities, recorded before its integrator;")
+md.append("  positions and forces are the same sequence as velocity Verlet's. Rebound velocities are")
+md.append("  taken after separation, where both are the same.")
+md.append("- **Shear cell**: the trajectories diverge within a few thousand steps (chaos amplifies")
+md.append("  rounding differences), so only time averages are compared. YADE's loaded wall starts")
+md.append("  with a leapfrog step (its initial velocity counts as v(-1/2)), a start-up offset of")
+md.append("  O(a dt^2) in the wall position that the flow forgets.")
+md.append("")
+with open(os.path.join(ROOT, "docs", "fidelity.md"), "w") as f:
+    f.write("\n".join(md))
+print("wrote docs/fidelity.md and", ", ".join(sorted(os.listdir(OUT))))
