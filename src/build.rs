@@ -16,7 +16,7 @@ use crate::observe::energy::{EnergyLedger, EnergyRow};
 use crate::pack::relaxed_packing;
 use crate::particles::Particles;
 use crate::pipeline::*;
-use crate::scene::{ControlSpec, Grains, Scene, SurfaceSpec, TangentialSpec};
+use crate::scene::{ControlSpec, Grains, Scene, SurfaceSpec, TangentialSpec, TimeStepRule};
 use crate::sim::{Simulation, World};
 use crate::timestep::{RefContact, TimeStepInfo, choose};
 use crate::walls::{Control, Surface, Wall};
@@ -40,6 +40,8 @@ pub trait Engine: Send {
     fn timings(&self) -> Vec<(String, Duration)>;
     /// The contact model in one line.
     fn model(&self) -> String;
+    /// The full state check ([`World::health`]).
+    fn health(&self) -> Result<(), Error>;
 }
 
 impl<L: ContactLaw> Engine for Simulation<L> {
@@ -82,6 +84,9 @@ impl<L: ContactLaw> Engine for Simulation<L> {
     fn model(&self) -> String {
         self.world.law.describe()
     }
+    fn health(&self) -> Result<(), Error> {
+        self.world.health()
+    }
 }
 
 /// What was built, besides the engine.
@@ -103,8 +108,17 @@ impl Built {
             *c = self.engine.model();
         }
         parts.retain(|s| s != "ClearForces" && s != "FinalKick");
+        let accuracy = match ts.accuracy {
+            Some(a) => format!(
+                "; chosen for {} <= {:e}: measured {:.2e} against a converged head-on impact",
+                a.quantity.name(),
+                a.tolerance,
+                a.measured_error
+            ),
+            None => String::new(),
+        };
         format!(
-            "{} (dt = {:.3e} s = t_c/{:.1}, t_c = {:.3e} s at {} m/s; stability limit {:.3e} s)",
+            "{} (dt = {:.3e} s = t_c/{:.1}, t_c = {:.3e} s at {} m/s; stability limit {:.3e} s{accuracy})",
             parts.join(" -> "),
             ts.dt_s,
             ts.steps_per_contact,
@@ -260,7 +274,16 @@ pub fn build(scene: &Scene) -> Result<Built, Error> {
     }
     let _ = reduced;
     let ts = &scene.time_step;
-    let time_step = choose(&ts.rule, ts.characteristic_speed, ts.allow_unstable, &refs, (r, m, mat), friction)?;
+    let time_step = match ts.rule {
+        TimeStepRule::Accuracy { quantity, tolerance, impact_speed } => {
+            let cal = crate::accuracy::calibrate(mat, r, impact_speed, scene.model.limit_force, quantity, tolerance)?;
+            let rule = TimeStepRule::StepsPerContact { steps: cal.steps_per_contact, impact_speed };
+            let mut info = choose(&rule, ts.characteristic_speed, ts.allow_unstable, &refs, (r, m, mat), friction)?;
+            info.accuracy = Some(crate::accuracy::AccuracyNote { quantity, tolerance, measured_error: cal.measured_error });
+            info
+        }
+        _ => choose(&ts.rule, ts.characteristic_speed, ts.allow_unstable, &refs, (r, m, mat), friction)?,
+    };
 
     let skin = scene.neighbor.skin * 2.0 * p.r[..n_free].iter().cloned().fold(f64::INFINITY, f64::min);
     let options = ModelOptions { limit_force: scene.model.limit_force, lever_arm: scene.model.lever_arm };
@@ -317,12 +340,16 @@ impl Parts<'_> {
             step: 0,
             max_overlap: (0.0, 0, 0),
             initial_energy: 0.0,
+            energy: E,
         };
         // The force stages, shared by the step and by the set-up at t = 0.
         let forces = || {
             let mut s: Vec<Box<dyn Stage<L<Dm, T>>>> = vec![Box::new(UpdateNeighbours), Box::new(ClearForces)];
             if gravity != Vec2::zeros() {
                 s.push(Box::new(Gravity::<E>));
+            }
+            if let Some(c) = scene.model.general_damping {
+                s.push(Box::new(GeneralDamping::<E>::new(c)));
             }
             s.push(Box::new(PairForces::<E>));
             if has_flat {

@@ -61,6 +61,26 @@ enum Command {
         #[arg(long)]
         csv: Option<PathBuf>,
     },
+    /// Run a scene over a list of time steps (and model variants) and write one CSV row
+    /// per run: dt, cost, and errors against the converged run and closed form.
+    Sweep {
+        scene: String,
+        /// Steps per Hertz contact time, comma-separated (e.g. 25,50,100,200).
+        #[arg(long, value_delimiter = ',')]
+        steps: Vec<f64>,
+        /// Fractions of the Rayleigh time, comma-separated.
+        #[arg(long, value_delimiter = ',')]
+        rayleigh: Vec<f64>,
+        /// Model variant families: tangential, clamp, lever (comma-separated).
+        #[arg(long, value_delimiter = ',')]
+        variants: Vec<String>,
+        /// Override the scene's duration, s.
+        #[arg(long)]
+        duration: Option<f64>,
+        /// CSV file to write (default: stdout).
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
     /// List the built-in scenes, or print one as JSON.
     Scenes { name: Option<String> },
 }
@@ -90,6 +110,9 @@ fn execute(cli: Cli) -> Result<(), Error> {
             let opts = RunOptions { out: out.clone(), progress: !quiet, duration };
             let summary = grainlab::run::run_built(&scene, built, &opts)?;
             eprint!("{}", timing_table(&summary));
+            if let Some(w) = summary.energy.as_ref().and_then(|e| e.warning.as_ref()) {
+                eprintln!("warning: {w}");
+            }
             println!("{}", serde_json::to_string_pretty(&summary).expect("serialisable"));
             if let Some(dir) = out {
                 eprintln!("wrote {}", dir.display());
@@ -120,6 +143,40 @@ fn execute(cli: Cli) -> Result<(), Error> {
             Ok(())
         }
         Command::Compare { root, filter, csv } => compare(&root, filter.as_deref(), csv.as_deref()),
+        Command::Sweep { scene, steps, rayleigh, variants, duration, out } => {
+            use grainlab::sweep::{Step, Variant, sweep};
+            let scene = load_scene(&scene)?;
+            let mut st: Vec<Step> = steps.iter().map(|&n| Step::PerContact(n)).collect();
+            st.extend(rayleigh.iter().map(|&f| Step::Rayleigh(f)));
+            for s in &st {
+                let (ok, v) = match *s {
+                    Step::PerContact(n) => (n.is_finite() && n >= 1.0, n),
+                    Step::Rayleigh(f) => (f > 0.0 && f <= 1.0, f),
+                };
+                grainlab::error::check(ok, "", if matches!(s, Step::PerContact(_)) { "--steps" } else { "--rayleigh" }, v, ">= 1 steps per contact, or a Rayleigh fraction in (0, 1]")?;
+            }
+            let mut vars = vec![Variant::Scene];
+            for f in &variants {
+                vars.extend(Variant::family(f)?);
+            }
+            let rows = sweep(&scene, &st, &vars, duration, |r| eprintln!("{:<28} {:<16} dt = {:.3e} s  {:.1} ns/particle-step", r.variant, r.rule, r.dt_s, r.ns_per_particle_step))?;
+            match out {
+                Some(path) => {
+                    let mut w = grainlab::output::csv::CsvSeries::create(&path)?;
+                    for r in &rows {
+                        w.row(r)?;
+                    }
+                    eprintln!("wrote {}", path.display());
+                }
+                None => {
+                    let mut w = csv::Writer::from_writer(std::io::stdout());
+                    for r in &rows {
+                        w.serialize(r).map_err(|e| Error::Other(e.to_string()))?;
+                    }
+                }
+            }
+            Ok(())
+        }
         Command::Scenes { name: None } => {
             for (n, d) in BUILTIN {
                 println!("{n:<10} {d}");

@@ -10,7 +10,8 @@
 //!    arrays, [`particles`]; the plane and grain shapes, [`dim`]) and a **pipeline**
 //!    ([`pipeline`]) of stages, only those the scene asks for: no walls, no wall stage; no
 //!    gravity, no gravity stage; no friction, no spin. The time step follows a rule and
-//!    is checked against the stability limit ([`timestep`]).
+//!    is checked against the stability limit ([`timestep`]), or picked for a stated accuracy
+//!    from the measured convergence of an impact ([`accuracy`]).
 //! 3. **Contact physics** ([`contact`]) is composed at compile time: Hertz normal force,
 //!    a damping form, a tangential formulation (LIGGGHTS' total displacement or YADE's
 //!    increments), one monomorphized kernel per named combination. Neighbours come
@@ -23,12 +24,14 @@
 //! 6. **Output** ([`output`]): `summary.json`, CSV time series with unit-suffixed headers,
 //!    ParaView `.vtp` frames with a `.pvd` index; [`run`] drives it all with a progress bar.
 //!
-//! 7. **Export** ([`export`]): the same scene as a LIGGGHTS deck or a YADE script, for the
+//! 7. **Sweeps** ([`sweep`]): a scene over time steps and model variants, error against cost.
+//! 8. **Export** ([`export`]): the same scene as a LIGGGHTS deck or a YADE script, for the
 //!    reference workbench ([`workbench`]: the cases under `reference/`, the reading of
 //!    the reference codes' output, the comparison) or for bigger machines.
 //!
 //! Everything is SI: m, kg, s, N, Pa, J.
 
+pub mod accuracy;
 pub mod boundary;
 pub mod build;
 pub mod contact;
@@ -48,6 +51,7 @@ pub mod scene;
 pub mod scenes;
 pub mod sim;
 pub mod stats;
+pub mod sweep;
 pub mod timestep;
 pub mod walls;
 pub mod workbench;

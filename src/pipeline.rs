@@ -115,6 +115,55 @@ impl<L: ContactLaw, const ENERGY: bool> Stage<L> for Gravity<ENERGY> {
     }
 }
 
+/// The seed's general damping: `F = -c m v`, `M = -c I w` on every free grain, with the
+/// half-step velocities the contact forces see. Its work is integrated by the trapezoid
+/// rule like every other term of the balance.
+pub struct GeneralDamping<const ENERGY: bool> {
+    /// Rate c, 1/s.
+    pub rate: f64,
+    prev_f: Vec<Vec2>,
+    prev_m: Vec<f64>,
+}
+
+impl<const ENERGY: bool> GeneralDamping<ENERGY> {
+    pub fn new(rate: f64) -> Self {
+        GeneralDamping { rate, prev_f: Vec::new(), prev_m: Vec::new() }
+    }
+}
+
+impl<L: ContactLaw, const ENERGY: bool> Stage<L> for GeneralDamping<ENERGY> {
+    fn name(&self) -> String {
+        format!("GeneralDamping(c = {} 1/s)", self.rate)
+    }
+    fn run(&mut self, w: &mut World<L>) -> Result<(), Error> {
+        let c = self.rate;
+        let n = w.p.n_free;
+        // The first call has no previous force: take this one (the set-up stages, run
+        // with dt = 0 before the first step, are a separate instance).
+        let first = ENERGY && self.prev_f.len() != n;
+        if first {
+            self.prev_f = vec![Vec2::zeros(); n];
+            self.prev_m = vec![0.0; n];
+        }
+        for i in 0..n {
+            let f = -c * w.p.m[i] * w.p.v[i];
+            let m = -c * w.p.inertia[i] * w.p.omega[i];
+            if first {
+                self.prev_f[i] = f;
+                self.prev_m[i] = m;
+            }
+            w.p.f[i] += f;
+            w.p.torque[i] += m;
+            if ENERGY {
+                w.ledger.general_damping -= 0.5 * ((self.prev_f[i] + f).dot(&w.p.v[i]) + (self.prev_m[i] + m) * w.p.omega[i]) * w.dt;
+                self.prev_f[i] = f;
+                self.prev_m[i] = m;
+            }
+        }
+        Ok(())
+    }
+}
+
 /// Grain-grain contacts over the Verlet list.
 pub struct PairForces<const ENERGY: bool>;
 

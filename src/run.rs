@@ -41,6 +41,32 @@ pub struct EnergySummary {
     /// Largest |residual| over the run relative to the energy put in (initial energy +
     /// the magnitudes of all work terms).
     pub max_residual_rel: f64,
+    /// Energy the tangential springs created (the tangential model work W_t) relative to
+    /// the energy the scene put in from outside (initial energy, walls, load, gravity).
+    /// It grows with dt at first order; above [`TANGENTIAL_WORK_WARNING`] the springs,
+    /// not the walls, drive the flow, and the run says so.
+    pub tangential_work_share: f64,
+    /// A warning when `tangential_work_share` is too large, else none.
+    pub warning: Option<String>,
+}
+
+/// Tangential model work, as a share of the external energy input, above which a run
+/// warns: half. The shear cell shows 0.2 at t_c/50, 0.8 at t_c/12.5 and 5 at t_c/5
+/// (docs/accuracy-cost.md).
+pub const TANGENTIAL_WORK_WARNING: f64 = 0.5;
+
+fn energy_summary(row: EnergyRow, max_residual_rel: f64, dt: f64) -> EnergySummary {
+    let external = row.initial_j + row.work_walls_j.abs() + row.work_load_j.abs() + row.work_gravity_j.abs();
+    let share = if external > 0.0 { row.tangential_model_work_j / external } else { 0.0 };
+    let warning = (share > TANGENTIAL_WORK_WARNING).then(|| {
+        format!(
+            "the tangential springs created {:.0}% as much energy as the scene put in (tangential model work {:.3e} J): the time step {:.3e} s is too coarse for the tangential law; use more steps per contact, or add model.general_damping",
+            100.0 * share,
+            row.tangential_model_work_j,
+            dt
+        )
+    });
+    EnergySummary { final_row: row, max_residual_rel, tangential_work_share: share, warning }
 }
 
 #[derive(Clone, Debug, Serialize, serde::Deserialize)]
@@ -154,6 +180,11 @@ pub fn run_built(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<S
         }
         walls_avg.accumulate(e);
         if k % sample_every == 0 || k == total {
+            if let Err(err) = e.health() {
+                error = Some(err);
+                record_energy(e, &mut outputs)?;
+                break;
+            }
             record_energy(e, &mut outputs)?;
             if let Some(row) = walls_avg.row(e, built.length, built.depth) {
                 if let Some(w) = outputs.walls.as_mut() {
@@ -173,6 +204,9 @@ pub fn run_built(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<S
             }
         }
         if impact.as_ref().is_some_and(|o| o.finished()) {
+            if let Err(err) = e.health() {
+                error = Some(err);
+            }
             record_energy(e, &mut outputs)?;
             break;
         }
@@ -198,7 +232,7 @@ pub fn run_built(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<S
         simulated_time_s: e.time(),
         wall_time_s: wall_time,
         particle_steps_per_s: p.n_free as f64 * e.steps() as f64 / wall_time.max(1e-9),
-        energy: energy_on.then(|| EnergySummary { final_row: e.energy_row(), max_residual_rel: max_res }),
+        energy: energy_on.then(|| energy_summary(e.energy_row(), max_res, dt)),
         impact: impact.as_ref().and_then(|o| o.summary()),
         shear,
         stage_timing,

@@ -206,6 +206,11 @@ pub struct ModelSpec {
     /// Integrate spins. Default true (ignored without friction).
     #[serde(default = "yes")]
     pub rotation: bool,
+    /// The seed's general damping: a viscous drag on every free grain, `F = -c m v`,
+    /// `M = -c I w`, with the rate `c` in 1/s (> 0). Its dissipation enters the energy
+    /// balance. Default none (no stage).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub general_damping: Option<f64>,
 }
 
 fn yes() -> bool {
@@ -214,7 +219,7 @@ fn yes() -> bool {
 
 impl Default for ModelSpec {
     fn default() -> Self {
-        ModelSpec { tangential: TangentialSpec::default(), limit_force: false, lever_arm: LeverArm::default(), rotation: true }
+        ModelSpec { tangential: TangentialSpec::default(), limit_force: false, lever_arm: LeverArm::default(), rotation: true, general_damping: None }
     }
 }
 
@@ -231,6 +236,10 @@ pub enum TimeStepRule {
     /// The seed's rule dt = factor x 2 sqrt(min m / max k), k = kn at an overlap of
     /// `reference_overlap` x the smallest radius.
     SeedRule { factor: f64, reference_overlap: f64 },
+    /// The largest dt whose measured error on `quantity` is within `tolerance`, from the
+    /// convergence of a head-on impact of the smallest grains at `impact_speed` (m/s);
+    /// see [`crate::accuracy`].
+    Accuracy { quantity: crate::accuracy::AccuracyQuantity, tolerance: f64, impact_speed: f64 },
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -388,6 +397,13 @@ impl Scene {
                 check(factor > 0.0 && factor <= 1.0, "time_step.rule.seed_rule", "factor", factor, "(0, 1]")?;
                 check(reference_overlap > 0.0 && reference_overlap < 1.0, "time_step.rule.seed_rule", "reference_overlap", reference_overlap, "(0, 1) of the smallest radius")?;
             }
+            TimeStepRule::Accuracy { tolerance, impact_speed, .. } => {
+                check(tolerance.is_finite() && tolerance > 0.0, "time_step.rule.accuracy", "tolerance", tolerance, "> 0")?;
+                check(finite_pos(impact_speed), "time_step.rule.accuracy", "impact_speed", impact_speed, "> 0 m/s")?;
+            }
+        }
+        if let Some(c) = self.model.general_damping {
+            check(finite_pos(c), "model", "general_damping", c, "> 0 1/s (omit it for none)")?;
         }
         if let Some(v) = self.time_step.characteristic_speed {
             check(finite_pos(v), "time_step", "characteristic_speed", v, "> 0 m/s")?;

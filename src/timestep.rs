@@ -41,6 +41,8 @@ pub struct TimeStepInfo {
     pub rayleigh_time_s: f64,
     /// Speed used for t_c and the stability limit, m/s.
     pub characteristic_speed_m_s: f64,
+    /// The accuracy target that chose dt, if the rule was `accuracy`.
+    pub accuracy: Option<crate::accuracy::AccuracyNote>,
 }
 
 /// Contact time, stability limit over the reference contacts at speed `v`.
@@ -69,7 +71,7 @@ pub fn choose(
     friction: bool,
 ) -> Result<TimeStepInfo, Error> {
     let v = characteristic_speed.unwrap_or(match rule {
-        TimeStepRule::StepsPerContact { impact_speed, .. } => *impact_speed,
+        TimeStepRule::StepsPerContact { impact_speed, .. } | TimeStepRule::Accuracy { impact_speed, .. } => *impact_speed,
         _ => 1.0,
     });
     let (tc, limit) = limits(refs, v, friction);
@@ -77,6 +79,7 @@ pub fn choose(
     let dt = match *rule {
         TimeStepRule::Fixed { dt } => dt,
         TimeStepRule::StepsPerContact { steps, impact_speed } => limits(refs, impact_speed, friction).0 / steps,
+        TimeStepRule::Accuracy { .. } => unreachable!("build() calibrates an accuracy rule into steps per contact first"),
         TimeStepRule::RayleighFraction { fraction } => fraction * rayleigh,
         TimeStepRule::SeedRule { factor, reference_overlap } => {
             let dn = reference_overlap * smallest.0;
@@ -102,5 +105,6 @@ pub fn choose(
         stability_limit_s: limit,
         rayleigh_time_s: rayleigh,
         characteristic_speed_m_s: v,
+        accuracy: None,
     })
 }

@@ -6,8 +6,8 @@
 //! that does not match the contact-point velocity, a wall force not counted) shows up
 //! at once in the residual.
 //!
-//! `residual = (E_kin + E_rot + E_wall + U_n + U_t) - E_0 + D_n + D_t + D_slip - W_t
-//!             - W_walls - W_load - W_gravity - W_general`
+//! `residual = (E_kin + E_rot + E_wall + U_n + U_t) - E_0 + D_n + D_t + D_slip + D_general
+//!             - W_t - W_walls - W_load - W_gravity`
 //! where `W_t` ("tangential model work") is the energy the tangential spring gains
 //! because its stiffness kt(dn) and its frame change under it. It is a property of the
 //! contact laws (neither LIGGGHTS' nor YADE's tangential spring is conservative), not a
@@ -24,6 +24,8 @@ pub struct EnergyLedger {
     pub tangential_damping: f64,
     /// Energy dissipated by sliding friction, J.
     pub friction: f64,
+    /// Energy dissipated by the general (viscous, per-grain) damping, J.
+    pub general_damping: f64,
     /// Energy the tangential spring gained from stiffness and frame changes, J.
     pub tangential_model: f64,
     /// Work done on the grains by the walls' prescribed motion, J.
@@ -58,6 +60,7 @@ pub struct EnergyRow {
     pub dissipated_normal_damping_j: f64,
     pub dissipated_tangential_damping_j: f64,
     pub dissipated_friction_j: f64,
+    pub dissipated_general_damping_j: f64,
     pub tangential_model_work_j: f64,
     pub work_walls_j: f64,
     pub work_load_j: f64,
@@ -83,7 +86,7 @@ impl EnergyRow {
     }
     /// Energy dissipated so far, J.
     pub fn dissipated(&self) -> f64 {
-        self.dissipated_normal_damping_j + self.dissipated_tangential_damping_j + self.dissipated_friction_j
+        self.dissipated_normal_damping_j + self.dissipated_tangential_damping_j + self.dissipated_friction_j + self.dissipated_general_damping_j
     }
     pub fn new(time: f64, kin: (f64, f64, f64), ledger: &EnergyLedger, initial: f64) -> Self {
         let mut r = EnergyRow {
@@ -96,6 +99,7 @@ impl EnergyRow {
             dissipated_normal_damping_j: ledger.normal_damping,
             dissipated_tangential_damping_j: ledger.tangential_damping,
             dissipated_friction_j: ledger.friction,
+            dissipated_general_damping_j: ledger.general_damping,
             tangential_model_work_j: ledger.tangential_model,
             work_walls_j: ledger.walls,
             work_load_j: ledger.load,
