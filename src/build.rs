@@ -155,6 +155,22 @@ fn read_particle_file(path: &str) -> Result<Vec<(Vec2, f64)>, Error> {
 
 /// Build the engine a scene describes.
 pub fn build(scene: &Scene) -> Result<Built, Error> {
+    build_with(scene, 1)
+}
+
+/// Build with the contact forces on `threads` threads (feature `parallel`; results are
+/// bit-identical to one thread).
+pub fn build_with(scene: &Scene, threads: usize) -> Result<Built, Error> {
+    if threads > 1 && !cfg!(feature = "parallel") {
+        return Err(Error::Invalid {
+            field: "--threads".into(),
+            value: threads.to_string(),
+            allowed: "1 (this build has no `parallel` feature: cargo build --release --features parallel)".into(),
+        });
+    }
+    if threads == 0 {
+        return Err(Error::Invalid { field: "--threads".into(), value: "0".into(), allowed: ">= 1".into() });
+    }
     scene.validate()?;
     let shape = scene.grain_shape;
     let mats = &scene.materials;
@@ -193,8 +209,10 @@ pub fn build(scene: &Scene) -> Result<Built, Error> {
             let lx = spec.x[1] - spec.x[0];
             let h = area / (spec.packing_fraction * lx);
             let centres = relaxed_packing(&radii, spec.x[0], spec.x[1], y0, y0 + h, boundary.is_periodic(), spec.seed);
-            for (x, r) in centres.into_iter().zip(radii) {
-                push(&mut p, x, Vec2::zeros(), 0.0, r, spec.material);
+            // A packing's order is arbitrary: store it along a space-filling curve.
+            let r_max = radii.iter().cloned().fold(0.0, f64::max);
+            for k in crate::pack::morton_order(&centres, spec.x[0], y0, 2.0 * r_max) {
+                push(&mut p, centres[k], Vec2::zeros(), 0.0, radii[k], spec.material);
             }
             if length == 0.0 {
                 length = lx;
@@ -288,7 +306,7 @@ pub fn build(scene: &Scene) -> Result<Built, Error> {
     let skin = scene.neighbor.skin * 2.0 * p.r[..n_free].iter().cloned().fold(f64::INFINITY, f64::min);
     let options = ModelOptions { limit_force: scene.model.limit_force, lever_arm: scene.model.lever_arm };
     let all_elastic = mats.iter().all(|m| m.restitution == 1.0);
-    let parts = Parts { p, boundary, walls, wall_material, dt: time_step.dt_s, skin, scene };
+    let parts = Parts { p, boundary, walls, wall_material, dt: time_step.dt_s, skin, scene, threads };
     let engine: Box<dyn Engine> = match (scene.model.tangential, all_elastic) {
         (TangentialSpec::Frictionless, false) => parts.assemble(HertzFrictionless::new(options))?,
         (TangentialSpec::Frictionless, true) => parts.assemble(HertzFrictionlessElastic::new(options))?,
@@ -308,6 +326,7 @@ struct Parts<'a> {
     dt: f64,
     skin: f64,
     scene: &'a Scene,
+    threads: usize,
 }
 
 impl Parts<'_> {
@@ -343,7 +362,8 @@ impl Parts<'_> {
             energy: E,
         };
         // The force stages, shared by the step and by the set-up at t = 0.
-        let forces = || {
+        let threads = self.threads;
+        let forces = || -> Result<Vec<Box<dyn Stage<L<Dm, T>>>>, Error> {
             let mut s: Vec<Box<dyn Stage<L<Dm, T>>>> = vec![Box::new(UpdateNeighbours), Box::new(ClearForces)];
             if gravity != Vec2::zeros() {
                 s.push(Box::new(Gravity::<E>));
@@ -351,11 +371,11 @@ impl Parts<'_> {
             if let Some(c) = scene.model.general_damping {
                 s.push(Box::new(GeneralDamping::<E>::new(c)));
             }
-            s.push(Box::new(PairForces::<E>));
+            s.push(pair_stage::<Dm, T, E>(threads)?);
             if has_flat {
                 s.push(Box::new(FlatWallForces::<E>));
             }
-            s
+            Ok(s)
         };
         let mut stages: Vec<Box<dyn Stage<L<Dm, T>>>> = Vec::new();
         if rotation {
@@ -369,7 +389,7 @@ impl Parts<'_> {
         if world.boundary.is_periodic() {
             stages.push(Box::new(PeriodicWrap));
         }
-        stages.extend(forces());
+        stages.extend(forces()?);
         if has_walls {
             stages.push(Box::new(FinishWalls::<E>));
         }
@@ -379,10 +399,20 @@ impl Parts<'_> {
             stages.push(Box::new(FinalIntegrate::<false>));
         }
         stages.push(Box::new(Watchdog { max_overlap: 0.1, every: 100 }));
-        let mut setup = forces();
+        let mut setup = forces()?;
         if has_walls {
             setup.push(Box::new(FinishWalls::<E>));
         }
         Ok(Box::new(Simulation::new(world, stages, setup)?))
     }
+}
+
+/// The grain-grain contact stage: serial, or on a pool of threads.
+fn pair_stage<Dm: Damping, T: Tangential, const E: bool>(threads: usize) -> Result<Box<dyn Stage<ContactModel<Dm, T>>>, Error> {
+    #[cfg(feature = "parallel")]
+    if threads > 1 {
+        return Ok(Box::new(crate::parallel::ParallelPairForces::<E>::new(threads)?));
+    }
+    let _ = threads;
+    Ok(Box::new(PairForces::<E>))
 }

@@ -29,6 +29,10 @@ enum Command {
         /// No progress bar.
         #[arg(long)]
         quiet: bool,
+        /// Threads for the contact forces (needs the `parallel` feature); results are
+        /// bit-identical to one thread.
+        #[arg(long, default_value_t = 1)]
+        threads: usize,
     },
     /// Print the step pipeline of a scene in one line, with dt and steps per contact.
     Explain { scene: String },
@@ -39,6 +43,9 @@ enum Command {
         scene: String,
         #[arg(long)]
         out: PathBuf,
+        /// A timing deck: record nothing, print the loop time (scripts/bench-peers).
+        #[arg(long)]
+        bench: bool,
     },
     /// Write the workbench cases (scene, case.json, decks) under a root folder.
     Cases {
@@ -100,12 +107,12 @@ pub fn load_scene(arg: &str) -> Result<Scene, Error> {
 
 fn execute(cli: Cli) -> Result<(), Error> {
     match cli.command {
-        Command::Run { scene, out, duration, quiet } => {
+        Command::Run { scene, out, duration, quiet, threads } => {
             let scene = load_scene(&scene)?;
             if let Some(d) = duration {
                 grainlab::error::check(d.is_finite() && d > 0.0, "", "--duration", d, "> 0 s")?;
             }
-            let built = build(&scene)?;
+            let built = grainlab::build_with(&scene, threads)?;
             eprintln!("{}", built.explain());
             let opts = RunOptions { out: out.clone(), progress: !quiet, duration };
             let summary = grainlab::run::run_built(&scene, built, &opts)?;
@@ -125,9 +132,9 @@ fn execute(cli: Cli) -> Result<(), Error> {
             println!("{}", build(&scene)?.explain());
             Ok(())
         }
-        Command::Export { code, scene, out } => {
+        Command::Export { code, scene, out, bench } => {
             let scene = load_scene(&scene)?;
-            for path in grainlab::export::export(&scene, code, &out)? {
+            for path in grainlab::export::export_with(&scene, code, &out, bench)? {
                 println!("{}", path.display());
             }
             Ok(())

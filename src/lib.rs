@@ -19,6 +19,8 @@
 //!    x may be periodic ([`boundary`]); walls are flat or rough, fixed or loaded ([`walls`]).
 //! 4. **Simulation** ([`sim`]): velocity Verlet ([`integrate`]) runs the stages each step,
 //!    timed per stage; a watchdog stops a run that goes unstable, with a diagnosis.
+//!    With the `parallel` feature the contact forces run on several threads, bit for bit
+//!    the same as on one ([`parallel`]).
 //! 5. **Observers** ([`observe`]): the energy balance, impact measurements, wall stresses,
 //!    with block-averaged confidence intervals ([`stats`]).
 //! 6. **Output** ([`output`]): `summary.json`, CSV time series with unit-suffixed headers,
@@ -44,6 +46,8 @@ pub mod neighbor;
 pub mod observe;
 pub mod output;
 pub mod pack;
+#[cfg(feature = "parallel")]
+pub mod parallel;
 pub mod particles;
 pub mod pipeline;
 pub mod run;
@@ -56,6 +60,6 @@ pub mod timestep;
 pub mod walls;
 pub mod workbench;
 
-pub use build::{Built, Engine, build};
+pub use build::{Built, Engine, build, build_with};
 pub use error::Error;
 pub use scene::Scene;

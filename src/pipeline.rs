@@ -164,6 +164,72 @@ impl<L: ContactLaw, const ENERGY: bool> Stage<L> for GeneralDamping<ENERGY> {
     }
 }
 
+/// What one grain-grain pair did this step, for the grains to collect.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct PairOut {
+    /// Force on the first grain (the second gets the opposite), N.
+    pub force: Vec2,
+    /// Torques to subtract from the first and the second grain, N m.
+    pub torque: [f64; 2],
+    /// Overlap over the smaller radius (0 when not touching).
+    pub ratio: f64,
+}
+
+/// One pair of the Verlet list: the contact force (touching), the end of a contact
+/// (released), or nothing; history and energy terms updated. Shared by the serial and
+/// the parallel stage, so that both compute the same bits.
+#[inline(always)]
+pub fn pair_contact<Dm: Damping, T: Tangential, const ENERGY: bool>(
+    w: &PairView<'_, ContactModel<Dm, T>>,
+    pair: [u32; 2],
+    h: &mut crate::sim::Hist<ContactModel<Dm, T>>,
+    ledger: &mut crate::observe::energy::EnergyLedger,
+) -> PairOut {
+    let model = w.law;
+    let lever = model.options.lever_arm;
+    let p = w.p;
+    let (i, j) = (pair[0] as usize, pair[1] as usize);
+    let d = w.boundary.image(p.x[i] - p.x[j]);
+    let rsq = d.norm_squared();
+    let (ri, rj) = (p.r[i], p.r[j]);
+    let radsum = ri + rj;
+    if rsq >= radsum * radsum {
+        if h.active {
+            let n = d / rsq.sqrt();
+            let spin = if T::FRICTION { ri * p.omega[i] + rj * p.omega[j] } else { 0.0 };
+            let vc = p.v[i] - p.v[j] + spin * Vec2::new(n.y, -n.x);
+            model.release::<ENERGY>(vc, n, w.dt, h, ledger);
+        }
+        return PairOut::default();
+    }
+    let r = rsq.sqrt();
+    let n = d / r;
+    let dn = radsum - r;
+    let (ai, aj) = if T::FRICTION { (lever.arm(ri, dn), lever.arm(rj, dn)) } else { (0.0, 0.0) };
+    let spin = if T::FRICTION { ai * p.omega[i] + aj * p.omega[j] } else { 0.0 };
+    let (mi, mj) = (p.m[i], p.m[j]);
+    let tangential_scale = if T::FRICTION { lever.translation_scale(radsum, dn) } else { 1.0 };
+    let input = ContactInput { n, dn, r_star: ri * rj / radsum, m_star: mi * mj / (mi + mj), v_rel: p.v[i] - p.v[j], spin, dt: w.dt, tangential_scale };
+    let pm = w.pair_table.get(p.material[i] as usize, p.material[j] as usize);
+    let c = model.touch::<ENERGY>(&input, pm, h, ledger);
+    let torque = if T::FRICTION {
+        let t = cross(n, c.tangential);
+        [lever.torque_arm(ri, dn) * t, lever.torque_arm(rj, dn) * t]
+    } else {
+        [0.0, 0.0]
+    };
+    PairOut { force: c.force, torque, ratio: dn / ri.min(rj) }
+}
+
+/// What the pair kernel reads: everything but the forces it produces.
+pub struct PairView<'a, L: ContactLaw> {
+    pub p: &'a crate::particles::Particles,
+    pub boundary: crate::boundary::Boundary,
+    pub law: L,
+    pub pair_table: &'a crate::material::PairTable,
+    pub dt: f64,
+}
+
 /// Grain-grain contacts over the Verlet list.
 pub struct PairForces<const ENERGY: bool>;
 
@@ -172,49 +238,29 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
         "PairContacts".into()
     }
     fn run(&mut self, w: &mut World<ContactModel<Dm, T>>) -> Result<(), Error> {
-        let model = w.law;
-        let lever = model.options.lever_arm;
-        let dt = w.dt;
-        let p = &mut w.p;
-        let b = w.boundary;
         let mut worst = w.max_overlap;
-        for (pair, h) in w.pairs.pairs.iter().zip(w.pairs.hist.iter_mut()) {
-            let (i, j) = (pair[0] as usize, pair[1] as usize);
-            let d = b.image(p.x[i] - p.x[j]);
-            let rsq = d.norm_squared();
-            let (ri, rj) = (p.r[i], p.r[j]);
-            let radsum = ri + rj;
-            if rsq >= radsum * radsum {
-                if h.active {
-                    let n = d / rsq.sqrt();
-                    let spin = if T::FRICTION { ri * p.omega[i] + rj * p.omega[j] } else { 0.0 };
-                    let vc = p.v[i] - p.v[j] + spin * Vec2::new(n.y, -n.x);
-                    model.release::<ENERGY>(vc, n, dt, h, &mut w.ledger);
+        let mut f = std::mem::take(&mut w.p.f);
+        let mut torque = std::mem::take(&mut w.p.torque);
+        {
+            let view = PairView { p: &w.p, boundary: w.boundary, law: w.law, pair_table: &w.pair_table, dt: w.dt };
+            for (pair, h) in w.pairs.pairs.iter().zip(w.pairs.hist.iter_mut()) {
+                let o = pair_contact::<Dm, T, ENERGY>(&view, *pair, h, &mut w.ledger);
+                if o.ratio > 0.0 {
+                    let (i, j) = (pair[0] as usize, pair[1] as usize);
+                    f[i] += o.force;
+                    f[j] -= o.force;
+                    if T::FRICTION {
+                        torque[i] -= o.torque[0];
+                        torque[j] -= o.torque[1];
+                    }
+                    if o.ratio > worst.0 {
+                        worst = (o.ratio, i, j);
+                    }
                 }
-                continue;
-            }
-            let r = rsq.sqrt();
-            let n = d / r;
-            let dn = radsum - r;
-            let (ai, aj) = if T::FRICTION { (lever.arm(ri, dn), lever.arm(rj, dn)) } else { (0.0, 0.0) };
-            let spin = if T::FRICTION { ai * p.omega[i] + aj * p.omega[j] } else { 0.0 };
-            let (mi, mj) = (p.m[i], p.m[j]);
-            let tangential_scale = if T::FRICTION { lever.translation_scale(radsum, dn) } else { 1.0 };
-            let input = ContactInput { n, dn, r_star: ri * rj / radsum, m_star: mi * mj / (mi + mj), v_rel: p.v[i] - p.v[j], spin, dt, tangential_scale };
-            let pm = w.pair_table.get(p.material[i] as usize, p.material[j] as usize);
-            let c = model.touch::<ENERGY>(&input, pm, h, &mut w.ledger);
-            p.f[i] += c.force;
-            p.f[j] -= c.force;
-            if T::FRICTION {
-                let t = cross(n, c.tangential);
-                p.torque[i] -= lever.torque_arm(ri, dn) * t;
-                p.torque[j] -= lever.torque_arm(rj, dn) * t;
-            }
-            let ratio = dn / ri.min(rj);
-            if ratio > worst.0 {
-                worst = (ratio, i, j);
             }
         }
+        w.p.f = f;
+        w.p.torque = torque;
         w.max_overlap = worst;
         Ok(())
     }

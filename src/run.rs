@@ -28,6 +28,7 @@ pub struct RunOptions {
     pub duration: Option<f64>,
 }
 
+
 #[derive(Clone, Debug, Serialize)]
 pub struct StageTime {
     pub stage: String,

@@ -103,6 +103,8 @@ pub fn wall_columns() -> Vec<String> {
 pub(crate) struct Exported {
     pub built: Built,
     pub info: ExportInfo,
+    /// A timing deck: no recording.
+    pub bench: bool,
 }
 
 pub(crate) fn prepare(scene: &Scene, code: Code) -> Result<Exported, Error> {
@@ -155,7 +157,7 @@ pub(crate) fn prepare(scene: &Scene, code: Code) -> Result<Exported, Error> {
         depth_m: built.depth,
         columns,
     };
-    Ok(Exported { built, info })
+    Ok(Exported { built, info, bench: false })
 }
 
 /// The shared particle file, LAMMPS data format for `atom_style granular`.
@@ -211,7 +213,15 @@ pub(crate) fn bounds(built: &Built, duration: f64) -> [[f64; 3]; 2] {
 
 /// Write the deck for `code`, the shared particle file and export.json into `dir`.
 pub fn export(scene: &Scene, code: Code, dir: &Path) -> Result<Vec<std::path::PathBuf>, Error> {
-    let ex = prepare(scene, code)?;
+    export_with(scene, code, dir, false)
+}
+
+/// As [`export`]; with `bench`, the deck records nothing (no per-step output, which would
+/// cost the reference code time that grainlab's own timing does not include) and prints
+/// its loop time: LIGGGHTS' `Loop time of ...`, YADE's `grainlab-loop-seconds ...`.
+pub fn export_with(scene: &Scene, code: Code, dir: &Path, bench: bool) -> Result<Vec<std::path::PathBuf>, Error> {
+    let mut ex = prepare(scene, code)?;
+    ex.bench = bench;
     let b = bounds(&ex.built, scene.duration);
     let deck = match code {
         Code::Liggghts => liggghts::deck(scene, &ex)?,

@@ -46,6 +46,7 @@ pub(crate) fn deck(scene: &Scene, ex: &Exported) -> Result<String, Error> {
     let _ = writeln!(w, "MU = [{}]", mats.iter().map(|m| f(if frictionless { 0.0 } else { m.friction })).collect::<Vec<_>>().join(", "));
     let _ = writeln!(w, "BETA = {}  # sqrt(5/6) |ln e| / sqrt(ln^2 e + pi^2)", f(beta));
     let _ = writeln!(w, "DT = {}\nSTEPS = {}", f(info.time_step_s), info.steps);
+    let _ = writeln!(w, "RECORD = {}  # False in a timing deck", if ex.bench { "False" } else { "True" });
     let _ = writeln!(w, "{}", COMMON);
     if info.analysis == Analysis::Shear {
         let b = e.boundary();
@@ -111,7 +112,7 @@ O.engines = [
         [Ip2_FrictMat_FrictMat_MindlinPhys(betan=BETA, betas=BETA)],
         [Law2_ScGeom_MindlinPhys_Mindlin()],
     ),
-    PyRunner(iterPeriod=1, command='record()'),
+] + ([PyRunner(iterPeriod=1, command='record()')] if RECORD else []) + [
     NewtonIntegrator(damping=0.0),
 ]
 O.dt = DT"#;
@@ -151,7 +152,10 @@ def record():
         out.write('%d %s\n' % (O.iter, ' '.join('%.17g' % (a / SAMPLE) for a in acc)))
         for k in range(5):
             acc[k] = 0.0
+import time
+t0 = time.time()
 O.run(STEPS, True)
+print('grainlab-loop-seconds %.6f' % (time.time() - t0))
 out.close()
 sys.exit(0)"#;
 
@@ -167,6 +171,9 @@ def record():
         fo = O.forces.f(i, sync=True)
         row += ['%.17g' % v for v in (st.pos[0], st.pos[1], st.vel[0], st.vel[1], st.angVel[2], fo[0], fo[1])]
     out.write(' '.join(row) + '\n')
+import time
+t0 = time.time()
 O.run(STEPS, True)
+print('grainlab-loop-seconds %.6f' % (time.time() - t0))
 out.close()
 sys.exit(0)"#;

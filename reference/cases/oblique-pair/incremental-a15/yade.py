@@ -10,6 +10,7 @@ MU = [5.00000000000000000e-1]
 BETA = 3.05980177796130147e-2  # sqrt(5/6) |ln e| / sqrt(ln^2 e + pi^2)
 DT = 3.14730528547887614e-8
 STEPS = 621
+RECORD = True  # False in a timing deck
 mats = [O.materials.append(FrictMat(young=E[k], poisson=NU[k], density=RHO[k], frictionAngle=math.atan(MU[k]))) for k in range(len(E))]
 def grains():
     """The spheres of grains.data, in order, not yet added to the scene."""
@@ -35,7 +36,7 @@ O.engines = [
         [Ip2_FrictMat_FrictMat_MindlinPhys(betan=BETA, betas=BETA)],
         [Law2_ScGeom_MindlinPhys_Mindlin()],
     ),
-    PyRunner(iterPeriod=1, command='record()'),
+] + ([PyRunner(iterPeriod=1, command='record()')] if RECORD else []) + [
     NewtonIntegrator(damping=0.0),
 ]
 O.dt = DT
@@ -52,6 +53,9 @@ def record():
         fo = O.forces.f(i, sync=True)
         row += ['%.17g' % v for v in (st.pos[0], st.pos[1], st.vel[0], st.vel[1], st.angVel[2], fo[0], fo[1])]
     out.write(' '.join(row) + '\n')
+import time
+t0 = time.time()
 O.run(STEPS, True)
+print('grainlab-loop-seconds %.6f' % (time.time() - t0))
 out.close()
 sys.exit(0)
