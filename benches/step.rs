@@ -1,4 +1,5 @@
-//! One step of the built-in shear cell, per contact model; and the neighbour rebuild.
+//! The contact kernel alone, one step of the built-in shear cell per contact model, and
+//! the neighbour rebuild.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use grainlab::boundary::Boundary;
@@ -37,5 +38,34 @@ fn neighbour_rebuild(c: &mut Criterion) {
     c.bench_function("cell_list_rebuild_1000_grains", |bch| bch.iter(|| cell_pairs(&p.x, &p.r, p.n_free, &b, 1e-4, &mut cs, &mut ci)));
 }
 
-criterion_group!(benches, shear_step, neighbour_rebuild);
+fn contact_kernel(c: &mut Criterion) {
+    use grainlab::contact::model::{LiggghtsHertzHistory, YadeMindlin};
+    use grainlab::contact::{ContactHistory, ContactInput, LeverArm, ModelOptions};
+    use grainlab::dim::Vec2;
+    use grainlab::material::{Material, PairMaterial};
+    use grainlab::observe::energy::EnergyLedger;
+    use std::hint::black_box;
+    // A sticking glass-glass contact of two 0.5 mm beads at a typical shear-cell overlap.
+    let pm = PairMaterial::mix(&Material::default(), &Material::default());
+    let input = ContactInput {
+        n: Vec2::new(0.6, 0.8),
+        dn: 1e-6,
+        r_star: 2.5e-4,
+        m_star: 6.5e-7,
+        v_rel: Vec2::new(1e-3, -2e-3),
+        spin: 1e-4,
+        dt: 5.8e-8,
+        tangential_scale: 1.0,
+    };
+    let options = ModelOptions { limit_force: false, lever_arm: LeverArm::Radius };
+    let mut ledger = EnergyLedger::default();
+    let l = LiggghtsHertzHistory::new(options);
+    let mut h = ContactHistory::default();
+    c.bench_function("contact_kernel_liggghts_history", |b| b.iter(|| l.touch::<false>(black_box(&input), &pm, &mut h, &mut ledger)));
+    let y = YadeMindlin::new(options);
+    let mut h = ContactHistory::default();
+    c.bench_function("contact_kernel_yade_mindlin", |b| b.iter(|| y.touch::<false>(black_box(&input), &pm, &mut h, &mut ledger)));
+}
+
+criterion_group!(benches, contact_kernel, shear_step, neighbour_rebuild);
 criterion_main!(benches);

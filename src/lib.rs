@@ -26,6 +26,8 @@
 //! 6. **Output** ([`output`]): `summary.json`, CSV time series with unit-suffixed headers,
 //!    ParaView `.vtp` frames with a `.pvd` index; [`run`] drives it all with a progress bar.
 //!
+//! Around a run:
+//!
 //! 7. **Sweeps** ([`sweep`]): a scene over time steps and model variants, error against cost.
 //! 8. **Export** ([`export`]): the same scene as a LIGGGHTS deck or a YADE script, for the
 //!    reference workbench ([`workbench`]: the cases under `reference/`, the reading of
