@@ -357,7 +357,35 @@ pub fn compare_shear(case: &str, code: Code, engine: &ShearSummary, reference: &
         ("normal_stress_pa", engine.normal_stress_pa, reference.normal_stress_pa),
         ("stress_ratio", engine.stress_ratio, reference.stress_ratio),
     ];
-    pairs.iter().map(|(q, a, b)| Row::new(case, code, q, a.mean, b.mean, (a.ci95 * a.ci95 + b.ci95 * b.ci95).sqrt(), false)).collect()
+    let mut rows: Vec<Row> = pairs.iter().map(|(q, a, b)| Row::new(case, code, q, a.mean, b.mean, (a.ci95 * a.ci95 + b.ci95 * b.ci95).sqrt(), false)).collect();
+    // Welch's t test on tau/sigma: the two block-average estimates have equal means unless
+    // p < 0.05. The row carries p as its "difference" from 1 so that the same pass rule
+    // (difference <= bound) reads p >= 0.05.
+    let p = welch_p(&engine.stress_ratio, &reference.stress_ratio);
+    let mut r = Row::new(case, code, "stress_ratio_welch_p_value", p, 1.0, 0.95, false);
+    r.pass = p >= 0.05;
+    rows.push(r);
+    rows
+}
+
+/// Two-sided p-value of Welch's t test for two block-average estimates (mean, 95% half
+/// width, number of blocks), with the Welch-Satterthwaite degrees of freedom (statrs).
+pub fn welch_p(a: &crate::stats::Estimate, b: &crate::stats::Estimate) -> f64 {
+    use statrs::distribution::{ContinuousCDF, StudentsT};
+    let se = |e: &crate::stats::Estimate| {
+        let t = StudentsT::new(0.0, 1.0, (e.blocks.max(2) - 1) as f64).expect("dof >= 1").inverse_cdf(0.975);
+        e.ci95 / t
+    };
+    let (sa, sb) = (se(a), se(b));
+    let (va, vb) = (sa * sa, sb * sb);
+    if va + vb == 0.0 {
+        return if a.mean == b.mean { 1.0 } else { 0.0 };
+    }
+    let t = (a.mean - b.mean) / (va + vb).sqrt();
+    let (na, nb) = ((a.blocks.max(2) - 1) as f64, (b.blocks.max(2) - 1) as f64);
+    let dof = (va + vb).powi(2) / (va * va / na + vb * vb / nb);
+    let dist = StudentsT::new(0.0, 1.0, dof).expect("dof > 0");
+    2.0 * (1.0 - dist.cdf(t.abs()))
 }
 
 /// Run the engine on a committed case and compare it with every code that has data.
@@ -374,8 +402,15 @@ pub fn compare_case(case_dir: &Path) -> Result<Vec<Row>, Error> {
         Analysis::Impact => {
             let e = engine_impact(&scene)?;
             let oblique = case.name.starts_with("oblique");
+            let curve = if case.curve { Some(engine_impact_curve(&scene)?.1) } else { None };
             for code in codes {
                 rows.extend(compare_impact(&case.name, code, &e, &expected_impact(case_dir, code)?, oblique));
+                // The force-overlap curve on a common normalised grid (50 overlaps per
+                // branch), its largest difference as a fraction of the peak force.
+                if let Some(c) = &curve {
+                    let d = curve_difference(c, &expected_curve(case_dir, code)?, 50);
+                    rows.push(Row::new(&case.name, code, "force_overlap_curve_diff_of_peak", d, 0.0, tolerance::PEAK, false));
+                }
             }
         }
         Analysis::Shear => {
