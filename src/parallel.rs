@@ -1,15 +1,16 @@
 //! Contact forces on several threads (feature `parallel`), bit for bit the same as on one.
 //!
 //! Floating-point sums depend on their order, so the parallel stage keeps the serial
-//! order of every addition. The Verlet list is sorted with i < j in each pair, so the
-//! serial loop adds to grain g first the pairs (m, g), m < g, in list order, then the
-//! pairs (g, j), which are contiguous in the list. The stage (1) computes every pair in
-//! parallel, keeping its force and first torque in list order and writing its second
-//! grain's share into that grain's own slot of a per-grain table (slots fixed at each
-//! neighbour rebuild); (2) lets every grain, in parallel, add its second-side entries then
-//! its contiguous first-side entries, both read sequentially: the serial sequence of
-//! additions, grain by grain; (3) gathers the energy terms and the largest overlap in list
-//! order. `tests/parallel.rs` checks identical bits with 1 and 2 threads.
+//! order of every addition. The Verlet list is sorted with i < j in each pair, and the
+//! serial loop adds to a grain g first its pairs (m, g), m < g, in list order, then its
+//! pairs (g, j). The grains (stored along a Z curve, so index ranges are compact in space)
+//! are split into one index range per thread, balanced by pair count. (1) The few pairs
+//! that join two ranges are computed first, in parallel, into their own slots. (2) Each
+//! thread then adds to its grains the cross pairs that come from earlier ranges (they are
+//! first in every grain's sequence), and runs the serial loop over the pairs whose first
+//! grain is its own, taking the cross pairs' results where they fall in the list. (3) The
+//! energy terms are merged in list order and the largest overlap picked as the serial
+//! loop would. `tests/parallel.rs` checks identical bits with 1 and 2 threads.
 
 use rayon::prelude::*;
 
@@ -20,35 +21,32 @@ use crate::dim::Vec2;
 use crate::error::Error;
 use crate::observe::energy::EnergyLedger;
 use crate::pipeline::{PairOut, PairView, Stage, pair_contact};
-use crate::sim::World;
+use crate::sim::{Hist, World};
 
-/// A grain's share of a pair in which it is the second grain.
-#[derive(Clone, Copy, Debug, Default)]
-struct Second {
-    force: Vec2,
-    torque: f64,
-    touching: bool,
-}
-
-/// Disjoint writes into a slice from parallel closures: each pair owns one slot.
+/// A pointer that parallel closures may share: every use writes a different element.
 #[derive(Clone, Copy)]
-struct Slots(*mut Second);
-unsafe impl Send for Slots {}
-unsafe impl Sync for Slots {}
+struct Shared<T>(*mut T);
+unsafe impl<T> Send for Shared<T> {}
+unsafe impl<T> Sync for Shared<T> {}
+
+const NOT_CROSS: u32 = u32::MAX;
 
 /// Grain-grain contacts on a pool of `threads` threads.
 pub struct ParallelPairForces<const ENERGY: bool> {
     pool: rayon::ThreadPool,
     threads: usize,
-    out: Vec<PairOut>,
-    ledgers: Vec<EnergyLedger>,
+    /// Grain index bounds of the ranges, `threads + 1` entries.
+    bounds: Vec<usize>,
     /// Pairs (g, j) of grain g: `first[g]..first[g + 1]` in the list.
-    first: Vec<u32>,
-    /// Entries of grain g as the second grain: `second[g]..second[g + 1]` in `seconds`.
-    second: Vec<u32>,
-    /// Slot in `seconds` of each pair.
-    slot: Vec<u32>,
-    seconds: Vec<Second>,
+    first: Vec<usize>,
+    /// The pairs joining two ranges, in list order, and each pair's slot among them.
+    cross: Vec<u32>,
+    cross_slot: Vec<u32>,
+    cross_out: Vec<PairOut>,
+    /// For each range, the slots of the cross pairs whose second grain is in it, in list order.
+    incoming: Vec<Vec<u32>>,
+    /// Energy terms of every pair, merged in list order (with the energy ledger only).
+    ledgers: Vec<EnergyLedger>,
     /// Neighbour-list build the tables belong to.
     built_for: u64,
 }
@@ -59,12 +57,13 @@ impl<const ENERGY: bool> ParallelPairForces<ENERGY> {
         Ok(ParallelPairForces {
             pool,
             threads,
-            out: Vec::new(),
-            ledgers: Vec::new(),
+            bounds: Vec::new(),
             first: Vec::new(),
-            second: Vec::new(),
-            slot: Vec::new(),
-            seconds: Vec::new(),
+            cross: Vec::new(),
+            cross_slot: Vec::new(),
+            cross_out: Vec::new(),
+            incoming: Vec::new(),
+            ledgers: Vec::new(),
             built_for: u64::MAX,
         })
     }
@@ -72,26 +71,40 @@ impl<const ENERGY: bool> ParallelPairForces<ENERGY> {
     fn tables(&mut self, n: usize, pairs: &[[u32; 2]]) {
         self.first.clear();
         self.first.resize(n + 1, 0);
-        self.second.clear();
-        self.second.resize(n + 1, 0);
         for p in pairs {
             debug_assert!(p[0] < p[1]);
             self.first[p[0] as usize + 1] += 1;
-            self.second[p[1] as usize + 1] += 1;
         }
         for g in 0..n {
             self.first[g + 1] += self.first[g];
-            self.second[g + 1] += self.second[g];
         }
-        let mut fill = self.second.clone();
-        self.slot.clear();
-        self.slot.extend(pairs.iter().map(|p| {
-            let s = &mut fill[p[1] as usize];
-            *s += 1;
-            *s - 1
-        }));
-        self.seconds.clear();
-        self.seconds.resize(pairs.len(), Second::default());
+        // Ranges with about the same number of pairs each.
+        let t = self.threads;
+        self.bounds.clear();
+        self.bounds.push(0);
+        for r in 1..t {
+            let target = pairs.len() * r / t;
+            let g = self.first.partition_point(|&c| c < target).min(n);
+            self.bounds.push(g.max(*self.bounds.last().unwrap()));
+        }
+        self.bounds.push(n);
+        let range_of = |g: usize, b: &[usize]| b.partition_point(|&x| x <= g) - 1;
+        self.cross.clear();
+        self.cross_slot.clear();
+        self.incoming = vec![Vec::new(); t];
+        for (k, p) in pairs.iter().enumerate() {
+            let (ri, rj) = (range_of(p[0] as usize, &self.bounds), range_of(p[1] as usize, &self.bounds));
+            if ri == rj {
+                self.cross_slot.push(NOT_CROSS);
+            } else {
+                let slot = self.cross.len() as u32;
+                self.cross_slot.push(slot);
+                self.cross.push(k as u32);
+                self.incoming[rj].push(slot);
+            }
+        }
+        self.cross_out.clear();
+        self.cross_out.resize(self.cross.len(), PairOut::default());
     }
 }
 
@@ -102,74 +115,114 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
     fn run(&mut self, w: &mut World<ContactModel<Dm, T>>) -> Result<(), Error> {
         let n = w.p.len();
         let np = w.pairs.pairs.len();
-        if self.built_for != w.neighbours.builds || self.first.len() != n + 1 || self.slot.len() != np {
+        if self.built_for != w.neighbours.builds || self.first.len() != n + 1 || self.cross_slot.len() != np {
             self.tables(n, &w.pairs.pairs);
             self.built_for = w.neighbours.builds;
         }
-        self.out.resize(np, PairOut::default());
         if ENERGY {
+            self.ledgers.clear();
             self.ledgers.resize(np, EnergyLedger::default());
         }
         let mut f = std::mem::take(&mut w.p.f);
         let mut torque = std::mem::take(&mut w.p.torque);
         let view = PairView { p: &w.p, boundary: w.boundary, law: w.law, pair_table: &w.pair_table, dt: w.dt };
-        let (pairs, hist) = (&w.pairs.pairs, &mut w.pairs.hist);
-        let (out, ledgers, slot) = (&mut self.out, &mut self.ledgers, &self.slot);
-        let (first, second) = (&self.first, &self.second);
-        let seconds = Slots(self.seconds.as_mut_ptr());
+        let pairs = &w.pairs.pairs;
+        let hist: Shared<Hist<ContactModel<Dm, T>>> = Shared(w.pairs.hist.as_mut_ptr());
+        let ledgers = Shared(self.ledgers.as_mut_ptr());
+        let (cross, cross_slot, incoming, bounds, first) = (&self.cross, &self.cross_slot, &self.incoming, &self.bounds, &self.first);
+        let cross_out = &mut self.cross_out;
+        let mut worsts: Vec<(f64, usize)> = vec![(0.0, usize::MAX); self.threads + 1];
         self.pool.install(|| {
-            // (1) Every pair: its own slot in list order, and its second grain's slot.
-            let one = |k: usize, pair: &[u32; 2], h: &mut _, o: &mut PairOut, l: &mut EnergyLedger| {
-                *o = pair_contact::<Dm, T, ENERGY>(&view, *pair, h, l);
-                let s = Second { force: o.force, torque: o.torque[1], touching: o.ratio > 0.0 };
-                // SAFETY: `slot` is a permutation of 0..np (built from the same list), so
-                // every pair writes a different element, and nothing reads until the join.
-                unsafe { *{ seconds }.0.add(slot[k] as usize) = s };
-            };
-            if ENERGY {
-                pairs.par_iter().zip(hist.par_iter_mut()).zip(out.par_iter_mut()).zip(ledgers.par_iter_mut()).enumerate().with_min_len(1024).for_each(
-                    |(k, (((pair, h), o), l))| {
-                        *l = EnergyLedger::default();
-                        one(k, pair, h, o, l);
-                    },
-                );
-            } else {
-                pairs.par_iter().zip(hist.par_iter_mut()).zip(out.par_iter_mut()).enumerate().with_min_len(1024).for_each(|(k, ((pair, h), o))| {
-                    one(k, pair, h, o, &mut EnergyLedger::default());
-                });
+            // (1) The pairs joining two ranges.
+            cross.par_iter().zip(cross_out.par_iter_mut()).with_min_len(256).for_each(|(&k, o)| {
+                let k = k as usize;
+                // SAFETY: every pair index appears once in `cross`, and phase (2) does not
+                // touch cross pairs' histories or ledgers: the writes are disjoint.
+                let h = unsafe { &mut *{ hist }.0.add(k) };
+                let mut local = EnergyLedger::default();
+                let l = if ENERGY { unsafe { &mut *{ ledgers }.0.add(k) } } else { &mut local };
+                *o = pair_contact::<Dm, T, ENERGY>(&view, pairs[k], h, l);
+            });
+            let cross_out = &*cross_out;
+            // (2) Each range: incoming cross pairs, then the serial loop over its pairs.
+            let mut f_parts = Vec::new();
+            let mut t_parts = Vec::new();
+            let (mut fr, mut tr) = (&mut f[..], &mut torque[..]);
+            for r in 0..self.threads {
+                let len = bounds[r + 1] - bounds[r];
+                let (a, b) = std::mem::take(&mut fr).split_at_mut(len);
+                let (c, d) = std::mem::take(&mut tr).split_at_mut(len);
+                f_parts.push(a);
+                t_parts.push(c);
+                fr = b;
+                tr = d;
             }
-            // (2) Every grain: its second-side entries, then its first-side pairs.
-            let (out, seconds) = (&*out, unsafe { std::slice::from_raw_parts(seconds.0 as *const Second, np) });
-            f.par_iter_mut().zip(torque.par_iter_mut()).enumerate().with_min_len(1024).for_each(|(g, (fg, tg))| {
-                for s in &seconds[second[g] as usize..second[g + 1] as usize] {
-                    if s.touching {
-                        *fg -= s.force;
-                        if T::FRICTION {
-                            *tg -= s.torque;
-                        }
-                    }
-                }
-                for o in &out[first[g] as usize..first[g + 1] as usize] {
+            f_parts.into_par_iter().zip(t_parts.into_par_iter()).zip(worsts.par_iter_mut()).enumerate().for_each(|(r, ((fl, tl), worst))| {
+                let g0 = bounds[r];
+                for &s in &incoming[r] {
+                    let o = &cross_out[s as usize];
                     if o.ratio > 0.0 {
-                        *fg += o.force;
+                        let g = pairs[cross[s as usize] as usize][1] as usize - g0;
+                        fl[g] -= o.force;
                         if T::FRICTION {
-                            *tg -= o.torque[0];
+                            tl[g] -= o.torque[1];
                         }
                     }
                 }
+                let mut best = (0.0, usize::MAX);
+                for k in first[g0]..first[bounds[r + 1]] {
+                    let pair = pairs[k];
+                    let (i, j) = (pair[0] as usize - g0, pair[1] as usize);
+                    let slot = cross_slot[k];
+                    if slot != NOT_CROSS {
+                        let o = &cross_out[slot as usize];
+                        if o.ratio > 0.0 {
+                            fl[i] += o.force;
+                            if T::FRICTION {
+                                tl[i] -= o.torque[0];
+                            }
+                            if o.ratio > best.0 {
+                                best = (o.ratio, k);
+                            }
+                        }
+                        continue;
+                    }
+                    // SAFETY: pair k's first grain is in this range and it is not a cross
+                    // pair, so no other thread touches its history or ledger.
+                    let h = unsafe { &mut *{ hist }.0.add(k) };
+                    let mut local = EnergyLedger::default();
+                    let l = if ENERGY { unsafe { &mut *{ ledgers }.0.add(k) } } else { &mut local };
+                    let o = pair_contact::<Dm, T, ENERGY>(&view, pair, h, l);
+                    if o.ratio > 0.0 {
+                        let j = j - g0;
+                        fl[i] += o.force;
+                        fl[j] -= o.force;
+                        if T::FRICTION {
+                            tl[i] -= o.torque[0];
+                            tl[j] -= o.torque[1];
+                        }
+                        if o.ratio > best.0 {
+                            best = (o.ratio, k);
+                        }
+                    }
+                }
+                *worst = best;
             });
         });
         w.p.f = f;
         w.p.torque = torque;
-        // (3) Energy terms and the largest overlap, in list order.
-        let mut worst = w.max_overlap;
-        for (k, o) in self.out.iter().enumerate() {
-            if o.ratio > worst.0 {
-                let p = w.pairs.pairs[k];
-                worst = (o.ratio, p[0] as usize, p[1] as usize);
+        // (3) The largest overlap as the serial loop picks it (the first of equal maxima),
+        // and the energy terms in list order.
+        let mut best = (0.0, usize::MAX);
+        for &(ratio, k) in &worsts {
+            if k != usize::MAX && (ratio > best.0 || (ratio == best.0 && k < best.1)) {
+                best = (ratio, k);
             }
         }
-        w.max_overlap = worst;
+        if best.1 != usize::MAX && best.0 > w.max_overlap.0 {
+            let p = w.pairs.pairs[best.1];
+            w.max_overlap = (best.0, p[0] as usize, p[1] as usize);
+        }
         if ENERGY {
             let g = &mut w.ledger;
             for l in &self.ledgers {
@@ -181,6 +234,7 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
                 g.elastic_tangential += l.elastic_tangential;
             }
         }
+        let _ = Vec2::zeros;
         Ok(())
     }
 }
