@@ -17,7 +17,6 @@ use rayon::prelude::*;
 use crate::contact::ContactModel;
 use crate::contact::damping::Damping;
 use crate::contact::tangential::Tangential;
-use crate::dim::Vec2;
 use crate::error::Error;
 use crate::observe::energy::EnergyLedger;
 use crate::pipeline::{PairOut, PairView, Stage, pair_contact};
@@ -234,7 +233,6 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
                 g.elastic_tangential += l.elastic_tangential;
             }
         }
-        let _ = Vec2::zeros;
         Ok(())
     }
 }

@@ -380,9 +380,7 @@ impl<L: ContactLaw> Stage<L> for Watchdog {
             return Err(w.unstable(what));
         }
         if w.step % self.every == 0 {
-            if let Some(i) = (0..w.p.n_free).find(|&i| !(w.p.x[i].x.is_finite() && w.p.x[i].y.is_finite() && w.p.v[i].norm_squared().is_finite() && w.p.omega[i].is_finite())) {
-                return Err(w.unstable(format!("grain {i} has a non-finite position or velocity")));
-            }
+            w.check_finite()?;
         }
         Ok(())
     }

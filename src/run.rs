@@ -108,6 +108,13 @@ struct Outputs {
     vtk: Option<VtkSeries>,
 }
 
+/// Steps of a run of `duration` s at `dt`, and the steps per output sample: the schedule
+/// every run follows, and that exported decks and calibrations copy.
+pub fn schedule(duration: f64, dt: f64, samples: u64) -> (u64, u64) {
+    let total = (duration / dt).ceil().max(1.0) as u64;
+    (total, (total / samples.max(1)).max(1))
+}
+
 /// Build and run a scene.
 pub fn run_scene(scene: &Scene, opts: &RunOptions) -> Result<Summary, Error> {
     let built = build(scene)?;
@@ -119,8 +126,7 @@ pub fn run_scene(scene: &Scene, opts: &RunOptions) -> Result<Summary, Error> {
 pub fn run_built(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<Summary, Error> {
     let duration = opts.duration.unwrap_or(scene.duration);
     let dt = built.time_step.dt_s;
-    let total = (duration / dt).ceil().max(1.0) as u64;
-    let sample_every = (total / scene.output.samples.max(1)).max(1);
+    let (total, sample_every) = schedule(duration, dt, scene.output.samples);
     let frame_every = if scene.output.frames > 0 { Some((total / scene.output.frames).max(1)) } else { None };
     let energy_on = scene.output.energy;
     let mut outputs = Outputs { energy: None, walls: None, vtk: None };

@@ -60,9 +60,7 @@ impl<L: ContactLaw> World<L> {
     /// in. The run loop calls it at every output sample and at the end of a run.
     pub fn health(&self) -> Result<(), Error> {
         let p = &self.p;
-        if let Some(i) = (0..p.n_free).find(|&i| !(p.x[i].x.is_finite() && p.x[i].y.is_finite() && p.v[i].norm_squared().is_finite() && p.omega[i].is_finite())) {
-            return Err(self.unstable(format!("grain {i} has a non-finite position or velocity")));
-        }
+        self.check_finite()?;
         if self.energy {
             let row = self.energy_row();
             let scale = row.put_in();
@@ -78,6 +76,15 @@ impl<L: ContactLaw> World<L> {
             }
         }
         Ok(())
+    }
+
+    /// An error naming the first free grain whose position, velocity or spin is not finite.
+    pub fn check_finite(&self) -> Result<(), Error> {
+        let p = &self.p;
+        match (0..p.n_free).find(|&i| !(p.x[i].x.is_finite() && p.x[i].y.is_finite() && p.v[i].norm_squared().is_finite() && p.omega[i].is_finite())) {
+            Some(i) => Err(self.unstable(format!("grain {i} has a non-finite position or velocity"))),
+            None => Ok(()),
+        }
     }
 
     pub(crate) fn unstable(&self, what: String) -> Error {

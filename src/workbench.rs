@@ -400,9 +400,14 @@ pub fn compare_case(case_dir: &Path) -> Result<Vec<Row>, Error> {
     }
     match scene.analysis {
         Analysis::Impact => {
-            let e = engine_impact(&scene)?;
+            // One engine run gives the summary, and the curve when the case keeps one.
+            let (e, curve) = if case.curve {
+                let (s, c) = engine_impact_curve(&scene)?;
+                (s, Some(c))
+            } else {
+                (engine_impact(&scene)?, None)
+            };
             let oblique = case.name.starts_with("oblique");
-            let curve = if case.curve { Some(engine_impact_curve(&scene)?.1) } else { None };
             for code in codes {
                 rows.extend(compare_impact(&case.name, code, &e, &expected_impact(case_dir, code)?, oblique));
                 // The force-overlap curve on a common normalised grid (50 overlaps per
@@ -449,7 +454,7 @@ pub fn case_dirs(root: &Path) -> Vec<PathBuf> {
 pub fn engine_impact_curve(scene: &Scene) -> Result<(ImpactSummary, Vec<CurvePoint>), Error> {
     let mut built = crate::build::build(scene)?;
     let e = built.engine.as_mut();
-    let total = (scene.duration / e.dt()).ceil() as u64;
+    let (total, _) = crate::run::schedule(scene.duration, e.dt(), scene.output.samples);
     let mut obs = ImpactObserver::default();
     obs.start(e);
     for _ in 0..total {

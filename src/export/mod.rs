@@ -77,12 +77,6 @@ pub struct ExportInfo {
     pub columns: Vec<String>,
 }
 
-/// Number of steps a run of `scene` takes, and the sampling interval: as in `run`.
-pub fn steps_of(scene: &Scene, built: &Built) -> (u64, u64) {
-    let total = (scene.duration / built.time_step.dt_s).ceil().max(1.0) as u64;
-    (total, (total / scene.output.samples.max(1)).max(1))
-}
-
 /// Columns of series.txt for an impact scene with `two` grains (else one grain on a wall).
 pub fn impact_columns(two: bool) -> Vec<String> {
     let mut c = vec!["step".to_string()];
@@ -116,7 +110,7 @@ pub(crate) fn prepare(scene: &Scene, code: Code) -> Result<Exported, Error> {
         return unsupported("gravity is not exported yet");
     }
     let built = build(scene)?;
-    let (steps, sample_every) = steps_of(scene, &built);
+    let (steps, sample_every) = crate::run::schedule(scene.duration, built.time_step.dt_s, scene.output.samples);
     let e = built.engine.as_ref();
     let n_free = e.particles().n_free;
     let walls = e.walls();
