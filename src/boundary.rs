@@ -27,15 +27,54 @@ impl Boundary {
     /// The minimum image of a separation vector.
     #[inline(always)]
     pub fn image(&self, mut d: Vec2) -> Vec2 {
-        d.x -= self.period * (d.x * self.inv_period).round();
+        d.x -= self.period * nearest_integer(d.x * self.inv_period);
         d
     }
     /// Bring a position back into [x_min, x_min + period).
     #[inline(always)]
     pub fn wrap(&self, x: &mut Vec2) {
         if self.period > 0.0 {
-            let s = ((x.x - self.x_min) * self.inv_period).floor();
+            let v = (x.x - self.x_min) * self.inv_period;
+            let s = nearest_integer(v);
+            let s = if s > v { s - 1.0 } else { s };
             x.x -= s * self.period;
         }
+    }
+}
+
+/// The integer nearest to `v` (ties to even), with two additions instead of a call to
+/// the C library's `round` (baseline x86-64 has no rounding instruction; this sits in
+/// the innermost loop). Exact for every finite `v`: from 2^51 on, `v` is an integer.
+#[inline(always)]
+pub fn nearest_integer(v: f64) -> f64 {
+    // 1.5 * 2^52: adding it leaves no fractional bits, so the sum is rounded to an integer.
+    const SHIFT: f64 = 6_755_399_441_055_744.0;
+    if v.abs() < 2_251_799_813_685_248.0 { (v + SHIFT) - SHIFT } else { v }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn nearest_integer_matches_round_away_from_ties() {
+        for &v in &[0.0, 0.49, 0.51, -0.49, -0.51, 1.2, -1.7, 3.0, -3.0, 1e10 + 0.3, -1e10 - 0.7, 1e300, -1e300, 4503599627370497.0] {
+            assert_eq!(nearest_integer(v), v.round(), "{v}");
+        }
+        assert_eq!(nearest_integer(2.5), 2.0);
+        assert_eq!(nearest_integer(-0.5).abs(), 0.0);
+    }
+
+    #[test]
+    fn wrap_and_image() {
+        let b = Boundary::periodic_x(-1.0, 4.0);
+        for &(x, want) in &[(-1.0, -1.0), (2.999, 2.999), (3.0, -1.0), (3.5, -0.5), (-1.5, 2.5), (11.25, -0.75)] {
+            let mut p = Vec2::new(x, 0.0);
+            b.wrap(&mut p);
+            assert!((p.x - want).abs() < 1e-12, "{x} -> {} (want {want})", p.x);
+        }
+        assert_eq!(b.image(Vec2::new(3.0, 1.0)), Vec2::new(-1.0, 1.0));
+        assert_eq!(b.image(Vec2::new(-2.9, 0.0)).x, -2.9 + 4.0);
+        assert_eq!(Boundary::open().image(Vec2::new(7.0, 1.0)), Vec2::new(7.0, 1.0));
     }
 }

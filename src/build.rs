@@ -414,5 +414,5 @@ fn pair_stage<Dm: Damping, T: Tangential, const E: bool>(threads: usize) -> Resu
         return Ok(Box::new(crate::parallel::ParallelPairForces::<E>::new(threads)?));
     }
     let _ = threads;
-    Ok(Box::new(PairForces::<E>))
+    Ok(Box::new(PairForces::<E>::default()))
 }

@@ -16,13 +16,32 @@ use crate::dim::Vec2;
 pub struct PairList<H> {
     /// Listed pairs, i < j, sorted.
     pub pairs: Vec<[u32; 2]>,
+    /// What each pair's kernel would otherwise divide out at every step, parallel to `pairs`.
+    pub consts: Vec<PairConst>,
     /// History of each pair, parallel to `pairs`.
     pub hist: Vec<ContactHistory<H>>,
 }
 
+/// The constants of a listed pair, computed once per neighbour-list build.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct PairConst {
+    /// Reduced radius R* = r_i r_j / (r_i + r_j), m.
+    pub r_star: f64,
+    /// Reduced mass m* = m_i m_j / (m_i + m_j), kg.
+    pub m_star: f64,
+    /// 1 / min(r_i, r_j), 1/m (overlap ratio for the watchdog).
+    pub inv_r_min: f64,
+}
+
 impl<H: Copy + Default> PairList<H> {
-    /// Replace the pairs, keeping the history of every pair that stays listed.
-    pub fn replace(&mut self, new_pairs: Vec<[u32; 2]>) {
+    /// Replace the pairs, keeping the history of every pair that stays listed, and
+    /// compute their constants from the radii `r` and masses `m`.
+    pub fn replace(&mut self, new_pairs: Vec<[u32; 2]>, r: &[f64], m: &[f64]) {
+        self.consts.clear();
+        self.consts.extend(new_pairs.iter().map(|&[i, j]| {
+            let (i, j) = (i as usize, j as usize);
+            PairConst { r_star: crate::material::reduced(r[i], r[j]), m_star: crate::material::reduced(m[i], m[j]), inv_r_min: 1.0 / r[i].min(r[j]) }
+        }));
         let mut hist = vec![ContactHistory::default(); new_pairs.len()];
         let mut k = 0;
         for (slot, p) in hist.iter_mut().zip(&new_pairs) {
@@ -220,13 +239,16 @@ mod tests {
     #[test]
     fn history_survives_a_rebuild_and_leaves_with_its_pair() {
         let mut list: PairList<f64> = PairList::default();
-        list.replace(vec![[0, 1], [0, 2], [3, 4]]);
+        let (r, m) = (vec![1.0; 5], vec![1.0; 5]);
+        list.replace(vec![[0, 1], [0, 2], [3, 4]], &r, &m);
         for (k, h) in list.hist.iter_mut().enumerate() {
             h.tangential = k as f64 + 1.0;
             h.active = true;
         }
         // [0, 2] leaves, [1, 2] and [2, 3] arrive, the others stay.
-        list.replace(vec![[0, 1], [1, 2], [2, 3], [3, 4]]);
+        list.replace(vec![[0, 1], [1, 2], [2, 3], [3, 4]], &r, &m);
+        assert_eq!(list.consts.len(), 4);
+        assert_eq!(list.consts[1].r_star, 0.5);
         let kept: Vec<f64> = list.hist.iter().map(|h| h.tangential).collect();
         assert_eq!(kept, vec![1.0, 0.0, 0.0, 3.0]);
         assert_eq!(list.touching(), 2);

@@ -126,6 +126,7 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
         let mut torque = std::mem::take(&mut w.p.torque);
         let view = PairView { p: &w.p, boundary: w.boundary, law: w.law, pair_table: &w.pair_table, dt: w.dt };
         let pairs = &w.pairs.pairs;
+        let consts = &w.pairs.consts;
         let hist: Shared<Hist<ContactModel<Dm, T>>> = Shared(w.pairs.hist.as_mut_ptr());
         let ledgers = Shared(self.ledgers.as_mut_ptr());
         let (cross, cross_slot, incoming, bounds, first) = (&self.cross, &self.cross_slot, &self.incoming, &self.bounds, &self.first);
@@ -140,7 +141,7 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
                 let h = unsafe { &mut *{ hist }.0.add(k) };
                 let mut local = EnergyLedger::default();
                 let l = if ENERGY { unsafe { &mut *{ ledgers }.0.add(k) } } else { &mut local };
-                *o = pair_contact::<Dm, T, ENERGY>(&view, pairs[k], h, l);
+                *o = pair_contact::<Dm, T, ENERGY>(&view, pairs[k], &consts[k], h, l);
             });
             let cross_out = &*cross_out;
             // (2) Each range: incoming cross pairs, then the serial loop over its pairs.
@@ -191,7 +192,7 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
                     let h = unsafe { &mut *{ hist }.0.add(k) };
                     let mut local = EnergyLedger::default();
                     let l = if ENERGY { unsafe { &mut *{ ledgers }.0.add(k) } } else { &mut local };
-                    let o = pair_contact::<Dm, T, ENERGY>(&view, pair, h, l);
+                    let o = pair_contact::<Dm, T, ENERGY>(&view, pair, &consts[k], h, l);
                     if o.ratio > 0.0 {
                         let j = j - g0;
                         fl[i] += o.force;

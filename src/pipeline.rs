@@ -71,7 +71,7 @@ impl<L: ContactLaw> Stage<L> for UpdateNeighbours {
     fn run(&mut self, w: &mut World<L>) -> Result<(), Error> {
         if w.neighbours.needs_rebuild(&w.p.x, &w.boundary) {
             let pairs = w.neighbours.build(&w.p.x, &w.p.r, w.p.n_free, &w.boundary);
-            w.pairs.replace(pairs);
+            w.pairs.replace(pairs, &w.p.r, &w.p.m);
         }
         Ok(())
     }
@@ -182,6 +182,7 @@ pub struct PairOut {
 pub fn pair_contact<Dm: Damping, T: Tangential, const ENERGY: bool>(
     w: &PairView<'_, ContactModel<Dm, T>>,
     pair: [u32; 2],
+    pc: &crate::neighbor::PairConst,
     h: &mut crate::sim::Hist<ContactModel<Dm, T>>,
     ledger: &mut crate::observe::energy::EnergyLedger,
 ) -> PairOut {
@@ -207,9 +208,8 @@ pub fn pair_contact<Dm: Damping, T: Tangential, const ENERGY: bool>(
     let dn = radsum - r;
     let (ai, aj) = if T::FRICTION { (lever.arm(ri, dn), lever.arm(rj, dn)) } else { (0.0, 0.0) };
     let spin = if T::FRICTION { ai * p.omega[i] + aj * p.omega[j] } else { 0.0 };
-    let (mi, mj) = (p.m[i], p.m[j]);
     let tangential_scale = if T::FRICTION { lever.translation_scale(radsum, dn) } else { 1.0 };
-    let input = ContactInput { n, dn, r_star: ri * rj / radsum, m_star: mi * mj / (mi + mj), v_rel: p.v[i] - p.v[j], spin, dt: w.dt, tangential_scale };
+    let input = ContactInput { n, dn, r_star: pc.r_star, m_star: pc.m_star, v_rel: p.v[i] - p.v[j], spin, dt: w.dt, tangential_scale };
     let pm = w.pair_table.get(p.material[i] as usize, p.material[j] as usize);
     let c = model.touch::<ENERGY>(&input, pm, h, ledger);
     let torque = if T::FRICTION {
@@ -218,7 +218,7 @@ pub fn pair_contact<Dm: Damping, T: Tangential, const ENERGY: bool>(
     } else {
         [0.0, 0.0]
     };
-    PairOut { force: c.force, torque, ratio: dn / ri.min(rj) }
+    PairOut { force: c.force, torque, ratio: dn * pc.inv_r_min }
 }
 
 /// What the pair kernel reads: everything but the forces it produces.
@@ -230,8 +230,34 @@ pub struct PairView<'a, L: ContactLaw> {
     pub dt: f64,
 }
 
-/// Grain-grain contacts over the Verlet list.
-pub struct PairForces<const ENERGY: bool>;
+/// Grain-grain contacts over the Verlet list, in two passes: a branch-free sweep picks
+/// the pairs that need the kernel (touching now, or touching at the previous step), then
+/// the kernel runs over those only, in list order. Most listed pairs are not touching
+/// (the skin): the sweep spares them the kernel's mispredicted branch.
+#[derive(Default)]
+pub struct PairForces<const ENERGY: bool> {
+    /// Indices into the pair list of the pairs this step works on.
+    work: Vec<u32>,
+}
+
+/// The pairs of `pairs[range]` that are touching or were touching at the previous step,
+/// as indices into `pairs`, appended to `work` in list order. No branch per pair.
+#[inline(never)]
+pub fn pairs_in_contact<H>(p: &crate::particles::Particles, boundary: &crate::boundary::Boundary, pairs: &[[u32; 2]], hist: &[crate::contact::ContactHistory<H>], range: std::ops::Range<usize>, work: &mut Vec<u32>) {
+    let start = work.len();
+    work.resize(start + range.len(), 0);
+    let mut count = start;
+    for k in range {
+        let pair = pairs[k];
+        let (i, j) = (pair[0] as usize, pair[1] as usize);
+        let d = boundary.image(p.x[i] - p.x[j]);
+        let radsum = p.r[i] + p.r[j];
+        let keep = (d.norm_squared() < radsum * radsum) | hist[k].active;
+        work[count] = k as u32;
+        count += keep as usize;
+    }
+    work.truncate(count);
+}
 
 impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> for PairForces<ENERGY> {
     fn name(&self) -> String {
@@ -241,10 +267,15 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
         let mut worst = w.max_overlap;
         let mut f = std::mem::take(&mut w.p.f);
         let mut torque = std::mem::take(&mut w.p.torque);
+        let pairs = &w.pairs.pairs;
+        self.work.clear();
+        pairs_in_contact(&w.p, &w.boundary, pairs, &w.pairs.hist, 0..pairs.len(), &mut self.work);
         {
             let view = PairView { p: &w.p, boundary: w.boundary, law: w.law, pair_table: &w.pair_table, dt: w.dt };
-            for (pair, h) in w.pairs.pairs.iter().zip(w.pairs.hist.iter_mut()) {
-                let o = pair_contact::<Dm, T, ENERGY>(&view, *pair, h, &mut w.ledger);
+            let (consts, hist) = (&w.pairs.consts, &mut w.pairs.hist);
+            for &k in &self.work {
+                let (pair, k) = (pairs[k as usize], k as usize);
+                let o = pair_contact::<Dm, T, ENERGY>(&view, pair, &consts[k], &mut hist[k], &mut w.ledger);
                 if o.ratio > 0.0 {
                     let (i, j) = (pair[0] as usize, pair[1] as usize);
                     f[i] += o.force;

@@ -79,19 +79,17 @@ impl Tangential for TotalDisplacement {
         *xi -= along_n * n;
         let elastic = -inp.kt * *xi;
         let f_el = elastic.norm();
-        if f_el > inp.cap {
-            if xi.norm_squared() != 0.0 {
-                let scaled = elastic * (inp.cap / f_el);
-                let before = 0.5 * inp.kt * xi.norm_squared();
-                *xi = -scaled / inp.kt;
-                let after = 0.5 * inp.kt * xi.norm_squared();
-                TangentialForce { elastic: scaled, damping: Vec2::zeros(), slip_energy: before - after }
-            } else {
-                TangentialForce::default()
-            }
-        } else {
-            TangentialForce { elastic, damping: -inp.gt * inp.vt, slip_energy: 0.0 }
-        }
+        // Branch-free: whether a contact slides is data, not control flow (about as often
+        // one way as the other in a sheared packing). cap >= 0, so sliding means f_el > 0.
+        let slide = f_el > inp.cap;
+        let scale = if slide { inp.cap / f_el } else { 1.0 };
+        let scaled = elastic * scale;
+        let before = 0.5 * inp.kt * xi.norm_squared();
+        let xi_slid = -scaled / inp.kt;
+        let after = 0.5 * inp.kt * xi_slid.norm_squared();
+        *xi = if slide { xi_slid } else { *xi };
+        let damping = -inp.gt * inp.vt;
+        TangentialForce { elastic: scaled, damping: if slide { Vec2::zeros() } else { damping }, slip_energy: if slide { before - after } else { 0.0 } }
     }
 }
 
