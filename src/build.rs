@@ -306,6 +306,10 @@ pub fn build_with(scene: &Scene, threads: usize) -> Result<Built, Error> {
     let skin = scene.neighbor.skin * 2.0 * p.r[..n_free].iter().cloned().fold(f64::INFINITY, f64::min);
     let options = ModelOptions { limit_force: scene.model.limit_force, lever_arm: scene.model.lever_arm };
     let all_elastic = mats.iter().all(|m| m.restitution == 1.0);
+    #[cfg(feature = "parallel")]
+    let threads = crate::threads::Threads::new(threads)?;
+    #[cfg(not(feature = "parallel"))]
+    let threads = crate::threads::Threads::serial();
     let parts = Parts { p, boundary, walls, wall_material, dt: time_step.dt_s, skin, scene, threads };
     let engine: Box<dyn Engine> = match (scene.model.tangential, all_elastic) {
         (TangentialSpec::Frictionless, false) => parts.assemble(HertzFrictionless::new(options))?,
@@ -326,7 +330,7 @@ struct Parts<'a> {
     dt: f64,
     skin: f64,
     scene: &'a Scene,
-    threads: usize,
+    threads: crate::threads::Threads,
 }
 
 impl Parts<'_> {
@@ -360,9 +364,10 @@ impl Parts<'_> {
             max_overlap: (0.0, 0, 0),
             initial_energy: 0.0,
             energy: E,
+            threads: self.threads.clone(),
         };
         // The force stages, shared by the step and by the set-up at t = 0.
-        let threads = self.threads;
+        let threads = self.threads.clone();
         let forces = || -> Result<Vec<Box<dyn Stage<L<Dm, T>>>>, Error> {
             let mut s: Vec<Box<dyn Stage<L<Dm, T>>>> = vec![Box::new(UpdateNeighbours), Box::new(ClearForces)];
             if gravity != Vec2::zeros() {
@@ -371,7 +376,7 @@ impl Parts<'_> {
             if let Some(c) = scene.model.general_damping {
                 s.push(Box::new(GeneralDamping::<E>::new(c)));
             }
-            s.push(pair_stage::<Dm, T, E>(threads)?);
+            s.push(pair_stage::<Dm, T, E>(&threads));
             if has_flat {
                 s.push(Box::new(FlatWallForces::<E>));
             }
@@ -379,9 +384,9 @@ impl Parts<'_> {
         };
         let mut stages: Vec<Box<dyn Stage<L<Dm, T>>>> = Vec::new();
         if rotation {
-            stages.push(Box::new(InitialIntegrate::<true>));
+            stages.push(Box::new(InitialIntegrate::<true>::default()));
         } else {
-            stages.push(Box::new(InitialIntegrate::<false>));
+            stages.push(Box::new(InitialIntegrate::<false>::default()));
         }
         if has_walls {
             stages.push(Box::new(MoveWalls));
@@ -394,9 +399,9 @@ impl Parts<'_> {
             stages.push(Box::new(FinishWalls::<E>));
         }
         if rotation {
-            stages.push(Box::new(FinalIntegrate::<true>));
+            stages.push(Box::new(FinalIntegrate::<true>::default()));
         } else {
-            stages.push(Box::new(FinalIntegrate::<false>));
+            stages.push(Box::new(FinalIntegrate::<false>::default()));
         }
         stages.push(Box::new(Watchdog { max_overlap: 0.1, every: 100 }));
         let mut setup = forces()?;
@@ -407,12 +412,12 @@ impl Parts<'_> {
     }
 }
 
-/// The grain-grain contact stage: serial, or on a pool of threads.
-fn pair_stage<Dm: Damping, T: Tangential, const E: bool>(threads: usize) -> Result<Box<dyn Stage<ContactModel<Dm, T>>>, Error> {
+/// The grain-grain contact stage: serial, or on the run's pool of threads.
+fn pair_stage<Dm: Damping, T: Tangential, const E: bool>(threads: &crate::threads::Threads) -> Box<dyn Stage<ContactModel<Dm, T>>> {
     #[cfg(feature = "parallel")]
-    if threads > 1 {
-        return Ok(Box::new(crate::parallel::ParallelPairForces::<E>::new(threads)?));
+    if threads.count() > 1 {
+        return Box::new(crate::parallel::ParallelPairForces::<E>::new(threads.clone()));
     }
     let _ = threads;
-    Ok(Box::new(PairForces::<E>::default()))
+    Box::new(PairForces::<E>::default())
 }

@@ -14,9 +14,9 @@ use std::f64::consts::PI;
 /// A vector in the plane, m (or m/s, N, ...).
 pub type Vec2 = nalgebra::Vector2<f64>;
 
-/// z-component of the cross product a x b.
+/// z-component of the cross product a x b (of one vector or of lanes of them).
 #[inline(always)]
-pub fn cross(a: Vec2, b: Vec2) -> f64 {
+pub fn cross<R: crate::lanes::Real>(a: nalgebra::Vector2<R>, b: nalgebra::Vector2<R>) -> R {
     a.x * b.y - a.y * b.x
 }
 

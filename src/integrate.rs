@@ -7,11 +7,39 @@
 
 use crate::contact::ContactLaw;
 use crate::error::Error;
+use crate::particles::Particles;
 use crate::pipeline::Stage;
 use crate::sim::World;
 
+/// The half-kick factors `dt/2 / m` and `dt/2 / I` of the free grains, divided out once
+/// per time step value instead of at every step (the same division, so the same bits as
+/// LIGGGHTS' `dtfm = dtf / rmass[i]`).
+#[derive(Default)]
+pub struct KickFactors {
+    dt: f64,
+    /// dt/2 / m, s/kg.
+    pub dtfm: Vec<f64>,
+    /// dt/2 / I, s/(kg m^2).
+    pub dtfi: Vec<f64>,
+}
+
+impl KickFactors {
+    fn update(&mut self, p: &Particles, dt: f64) {
+        let n = p.n_free;
+        if self.dt != dt || self.dtfm.len() != n {
+            let dtf = 0.5 * dt;
+            self.dt = dt;
+            self.dtfm = p.m[..n].iter().map(|m| dtf / m).collect();
+            self.dtfi = p.inertia[..n].iter().map(|i| dtf / i).collect();
+        }
+    }
+}
+
 /// First half kick and drift of the free grains; `ROT` adds the spin half kick.
-pub struct InitialIntegrate<const ROT: bool>;
+#[derive(Default)]
+pub struct InitialIntegrate<const ROT: bool> {
+    k: KickFactors,
+}
 
 impl<L: ContactLaw, const ROT: bool> Stage<L> for InitialIntegrate<ROT> {
     fn name(&self) -> String {
@@ -19,42 +47,52 @@ impl<L: ContactLaw, const ROT: bool> Stage<L> for InitialIntegrate<ROT> {
     }
     fn run(&mut self, w: &mut World<L>) -> Result<(), Error> {
         let dt = w.dt;
-        let dtf = 0.5 * dt;
         let p = &mut w.p;
         let n = p.n_free;
-        for i in 0..n {
-            let dtfm = dtf / p.m[i];
-            p.v[i] += dtfm * p.f[i];
-            p.x[i] += dt * p.v[i];
-        }
-        if ROT {
-            for i in 0..n {
-                p.omega[i] += dtf / p.inertia[i] * p.torque[i];
-                p.theta[i] += dt * p.omega[i];
+        self.k.update(p, dt);
+        w.threads.split(n, (&mut p.v[..n], &mut p.x[..n], &p.f[..n], &self.k.dtfm[..]), |(v, x, f, dtfm)| {
+            for i in 0..v.len() {
+                v[i] += dtfm[i] * f[i];
+                x[i] += dt * v[i];
             }
+        });
+        if ROT {
+            w.threads.split(n, (&mut p.omega[..n], &mut p.theta[..n], &p.torque[..n], &self.k.dtfi[..]), |(omega, theta, torque, dtfi)| {
+                for i in 0..omega.len() {
+                    omega[i] += dtfi[i] * torque[i];
+                    theta[i] += dt * omega[i];
+                }
+            });
         }
         Ok(())
     }
 }
 
 /// Second half kick of the free grains.
-pub struct FinalIntegrate<const ROT: bool>;
+#[derive(Default)]
+pub struct FinalIntegrate<const ROT: bool> {
+    k: KickFactors,
+}
 
 impl<L: ContactLaw, const ROT: bool> Stage<L> for FinalIntegrate<ROT> {
     fn name(&self) -> String {
         "FinalKick".into()
     }
     fn run(&mut self, w: &mut World<L>) -> Result<(), Error> {
-        let dtf = 0.5 * w.dt;
         let p = &mut w.p;
-        for i in 0..p.n_free {
-            let dtfm = dtf / p.m[i];
-            p.v[i] += dtfm * p.f[i];
-        }
-        if ROT {
-            for i in 0..p.n_free {
-                p.omega[i] += dtf / p.inertia[i] * p.torque[i];
+        let n = p.n_free;
+        self.k.update(p, w.dt);
+        w.threads.split(n, (&mut p.v[..n], &p.f[..n], &self.k.dtfm[..]), |(v, f, dtfm)| {
+            for i in 0..v.len() {
+                v[i] += dtfm[i] * f[i];
             }
+        });
+        if ROT {
+            w.threads.split(n, (&mut p.omega[..n], &p.torque[..n], &self.k.dtfi[..]), |(omega, torque, dtfi)| {
+                for i in 0..omega.len() {
+                    omega[i] += dtfi[i] * torque[i];
+                }
+            });
         }
         Ok(())
     }

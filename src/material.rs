@@ -94,19 +94,34 @@ pub fn beta(restitution: f64) -> f64 {
     l / (l * l + std::f64::consts::PI * std::f64::consts::PI).sqrt()
 }
 
-/// The mixed properties of one material pair.
+/// The mixed properties of one material pair (`R = Lanes`: of four pairs, one per lane).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct PairMaterial {
+pub struct PairMaterial<R = f64> {
     /// Effective Young's modulus E*, Pa.
-    pub e_star: f64,
+    pub e_star: R,
     /// Effective shear modulus G*, Pa.
-    pub g_star: f64,
+    pub g_star: R,
     /// Restitution of the pair (the smaller one).
-    pub restitution: f64,
+    pub restitution: R,
     /// beta(e) of the pair.
-    pub beta: f64,
+    pub beta: R,
     /// Friction coefficient of the pair (the smaller one).
-    pub friction: f64,
+    pub friction: R,
+}
+
+impl PairMaterial<crate::lanes::Lanes> {
+    /// Four pairs' properties in lanes.
+    #[inline(always)]
+    pub fn gather(pm: [&PairMaterial; crate::lanes::LANES]) -> Self {
+        use crate::lanes::gather;
+        PairMaterial {
+            e_star: gather(|l| pm[l].e_star),
+            g_star: gather(|l| pm[l].g_star),
+            restitution: gather(|l| pm[l].restitution),
+            beta: gather(|l| pm[l].beta),
+            friction: gather(|l| pm[l].friction),
+        }
+    }
 }
 
 impl PairMaterial {

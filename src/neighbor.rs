@@ -80,12 +80,20 @@ impl Neighbours {
     }
 
     /// True when some grain has moved more than half the skin since the last build.
-    pub fn needs_rebuild(&self, x: &[Vec2], boundary: &Boundary) -> bool {
+    /// A full sweep without an early exit, so that it vectorises.
+    pub fn needs_rebuild(&self, x: &[Vec2], boundary: &Boundary, threads: &crate::threads::Threads) -> bool {
         if self.x_at_build.len() != x.len() {
             return true;
         }
         let limit = 0.25 * self.skin * self.skin;
-        x.iter().zip(&self.x_at_build).any(|(a, b)| boundary.image(a - b).norm_squared() > limit)
+        let moved = std::sync::atomic::AtomicBool::new(false);
+        threads.split(x.len(), (x, &self.x_at_build[..]), |(x, at_build)| {
+            let far = x.iter().zip(at_build).fold(false, |far, (a, b)| far | (boundary.image(a - b).norm_squared() > limit));
+            if far {
+                moved.store(true, std::sync::atomic::Ordering::Relaxed);
+            }
+        });
+        moved.into_inner()
     }
 
     /// Build the pair list with the cell list.

@@ -4,103 +4,120 @@
 //! order of every addition. The Verlet list is sorted with i < j in each pair, and the
 //! serial loop adds to a grain g first its pairs (m, g), m < g, in list order, then its
 //! pairs (g, j). The grains (stored along a Z curve, so index ranges are compact in space)
-//! are split into one index range per thread, balanced by pair count. (1) The few pairs
-//! that join two ranges are computed first, in parallel, into their own slots. (2) Each
-//! thread then adds to its grains the cross pairs that come from earlier ranges (they are
-//! first in every grain's sequence), and runs the serial loop over the pairs whose first
-//! grain is its own, taking the cross pairs' results where they fall in the list. (3) The
+//! are split into one index range per thread, balanced by pair count; the pairs whose
+//! first grain is in a range are a contiguous part of the list, with their histories.
+//! (1) Each thread computes the few pairs of its part that join two ranges ("cross"
+//! pairs). (2) Each thread adds to its grains the cross pairs that come from earlier
+//! ranges (they are first in every grain's sequence), then runs the serial stage's two
+//! passes over the rest of its part (sort out the touching pairs, compute them four at a
+//! time) and adds the results in list order, the cross pairs' where they fall. (3) The
 //! energy terms are merged in list order and the largest overlap picked as the serial
 //! loop would. `tests/parallel.rs` checks identical bits with 1 and 2 threads.
-
-use rayon::prelude::*;
 
 use crate::contact::ContactModel;
 use crate::contact::damping::Damping;
 use crate::contact::tangential::Tangential;
 use crate::error::Error;
 use crate::observe::energy::EnergyLedger;
-use crate::pipeline::{PairOut, PairView, Stage, pair_contact};
-use crate::sim::{Hist, World};
-
-/// A pointer that parallel closures may share: every use writes a different element.
-#[derive(Clone, Copy)]
-struct Shared<T>(*mut T);
-unsafe impl<T> Send for Shared<T> {}
-unsafe impl<T> Sync for Shared<T> {}
+use crate::pipeline::{Ledgers, PairOut, PairSlices, PairView, Stage, compute_pairs, pair_contact, sort_pairs};
+use crate::sim::World;
+use crate::threads::Threads;
 
 const NOT_CROSS: u32 = u32::MAX;
 
-/// Grain-grain contacts on a pool of `threads` threads.
+/// One thread's working lists.
+#[derive(Default)]
+struct Scratch {
+    touching: Vec<u32>,
+    released: Vec<u32>,
+    out: Vec<PairOut>,
+    /// Largest overlap ratio of the part and its pair index.
+    worst: (f64, usize),
+}
+
+/// Grain-grain contacts on the run's thread pool.
 pub struct ParallelPairForces<const ENERGY: bool> {
-    pool: rayon::ThreadPool,
-    threads: usize,
+    threads: Threads,
     /// Grain index bounds of the ranges, `threads + 1` entries.
     bounds: Vec<usize>,
-    /// Pairs (g, j) of grain g: `first[g]..first[g + 1]` in the list.
-    first: Vec<usize>,
+    /// Pair index bounds of the ranges' parts of the list.
+    pair_bounds: Vec<usize>,
     /// The pairs joining two ranges, in list order, and each pair's slot among them.
     cross: Vec<u32>,
     cross_slot: Vec<u32>,
+    /// Slot bounds of each range's cross pairs (those whose first grain it owns).
+    cross_bounds: Vec<usize>,
     cross_out: Vec<PairOut>,
     /// For each range, the slots of the cross pairs whose second grain is in it, in list order.
     incoming: Vec<Vec<u32>>,
     /// Energy terms of every pair, merged in list order (with the energy ledger only).
     ledgers: Vec<EnergyLedger>,
+    scratch: Vec<Scratch>,
     /// Neighbour-list build the tables belong to.
     built_for: u64,
 }
 
+/// `v` cut at `bounds` (from 0 to `v.len()`) into consecutive parts.
+fn cut<'a, T>(mut v: &'a mut [T], bounds: &[usize]) -> Vec<&'a mut [T]> {
+    let mut parts = Vec::with_capacity(bounds.len());
+    for w in bounds.windows(2) {
+        let (a, b) = std::mem::take(&mut v).split_at_mut(w[1] - w[0]);
+        parts.push(a);
+        v = b;
+    }
+    parts
+}
+
 impl<const ENERGY: bool> ParallelPairForces<ENERGY> {
-    pub fn new(threads: usize) -> Result<Self, Error> {
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().map_err(|e| Error::Other(format!("thread pool: {e}")))?;
-        Ok(ParallelPairForces {
-            pool,
+    pub fn new(threads: Threads) -> Self {
+        let t = threads.count();
+        ParallelPairForces {
             threads,
             bounds: Vec::new(),
-            first: Vec::new(),
+            pair_bounds: Vec::new(),
             cross: Vec::new(),
             cross_slot: Vec::new(),
+            cross_bounds: Vec::new(),
             cross_out: Vec::new(),
             incoming: Vec::new(),
             ledgers: Vec::new(),
+            scratch: (0..t).map(|_| Scratch::default()).collect(),
             built_for: u64::MAX,
-        })
+        }
     }
 
     fn tables(&mut self, n: usize, pairs: &[[u32; 2]]) {
-        self.first.clear();
-        self.first.resize(n + 1, 0);
+        let mut first = vec![0usize; n + 1];
         for p in pairs {
             debug_assert!(p[0] < p[1]);
-            self.first[p[0] as usize + 1] += 1;
+            first[p[0] as usize + 1] += 1;
         }
         for g in 0..n {
-            self.first[g + 1] += self.first[g];
+            first[g + 1] += first[g];
         }
-        // Ranges with about the same number of pairs each.
-        let t = self.threads;
-        self.bounds.clear();
-        self.bounds.push(0);
-        for r in 1..t {
-            let target = pairs.len() * r / t;
-            let g = self.first.partition_point(|&c| c < target).min(n);
-            self.bounds.push(g.max(*self.bounds.last().unwrap()));
-        }
-        self.bounds.push(n);
+        // The threads' grain ranges of the per-grain stages, so that each thread works
+        // on the same grains (in its cache) in every stage.
+        let t = self.scratch.len();
+        self.bounds = self.threads.bounds(n);
+        self.pair_bounds = self.bounds.iter().map(|&g| first[g]).collect();
         let range_of = |g: usize, b: &[usize]| b.partition_point(|&x| x <= g) - 1;
         self.cross.clear();
         self.cross_slot.clear();
+        self.cross_bounds = vec![0];
         self.incoming = vec![Vec::new(); t];
-        for (k, p) in pairs.iter().enumerate() {
-            let (ri, rj) = (range_of(p[0] as usize, &self.bounds), range_of(p[1] as usize, &self.bounds));
-            if ri == rj {
-                self.cross_slot.push(NOT_CROSS);
-            } else {
-                let slot = self.cross.len() as u32;
-                self.cross_slot.push(slot);
-                self.cross.push(k as u32);
-                self.incoming[rj].push(slot);
+        for r in 0..t {
+            for k in self.pair_bounds[r]..self.pair_bounds[r + 1] {
+                let rj = range_of(pairs[k][1] as usize, &self.bounds);
+                if rj == r {
+                    self.cross_slot.push(NOT_CROSS);
+                } else {
+                    let slot = self.cross.len() as u32;
+                    self.cross_slot.push(slot);
+                    self.cross.push(k as u32);
+                    self.incoming[rj].push(slot);
+                }
             }
+            self.cross_bounds.push(self.cross.len());
         }
         self.cross_out.clear();
         self.cross_out.resize(self.cross.len(), PairOut::default());
@@ -109,56 +126,46 @@ impl<const ENERGY: bool> ParallelPairForces<ENERGY> {
 
 impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> for ParallelPairForces<ENERGY> {
     fn name(&self) -> String {
-        format!("PairContacts(parallel, {} threads)", self.threads)
+        format!("PairContacts(parallel, {} threads)", self.scratch.len())
     }
     fn run(&mut self, w: &mut World<ContactModel<Dm, T>>) -> Result<(), Error> {
         let n = w.p.len();
         let np = w.pairs.pairs.len();
-        if self.built_for != w.neighbours.builds || self.first.len() != n + 1 || self.cross_slot.len() != np {
+        if self.built_for != w.neighbours.builds || self.cross_slot.len() != np || *self.bounds.last().unwrap_or(&usize::MAX) != n {
             self.tables(n, &w.pairs.pairs);
             self.built_for = w.neighbours.builds;
         }
-        if ENERGY {
-            self.ledgers.clear();
-            self.ledgers.resize(np, EnergyLedger::default());
-        }
+        self.ledgers.clear();
+        self.ledgers.resize(if ENERGY { np } else { 0 }, EnergyLedger::default());
+        let ledger_bounds: Vec<usize> = if ENERGY { self.pair_bounds.clone() } else { vec![0; self.pair_bounds.len()] };
         let mut f = std::mem::take(&mut w.p.f);
         let mut torque = std::mem::take(&mut w.p.torque);
         let view = PairView { p: &w.p, boundary: w.boundary, law: w.law, pair_table: &w.pair_table, dt: w.dt };
-        let pairs = &w.pairs.pairs;
-        let consts = &w.pairs.consts;
-        let hist: Shared<Hist<ContactModel<Dm, T>>> = Shared(w.pairs.hist.as_mut_ptr());
-        let ledgers = Shared(self.ledgers.as_mut_ptr());
-        let (cross, cross_slot, incoming, bounds, first) = (&self.cross, &self.cross_slot, &self.incoming, &self.bounds, &self.first);
-        let cross_out = &mut self.cross_out;
-        let mut worsts: Vec<(f64, usize)> = vec![(0.0, usize::MAX); self.threads + 1];
-        self.pool.install(|| {
-            // (1) The pairs joining two ranges.
-            cross.par_iter().zip(cross_out.par_iter_mut()).with_min_len(256).for_each(|(&k, o)| {
-                let k = k as usize;
-                // SAFETY: every pair index appears once in `cross`, and phase (2) does not
-                // touch cross pairs' histories or ledgers: the writes are disjoint.
-                let h = unsafe { &mut *{ hist }.0.add(k) };
-                let mut local = EnergyLedger::default();
-                let l = if ENERGY { unsafe { &mut *{ ledgers }.0.add(k) } } else { &mut local };
-                *o = pair_contact::<Dm, T, ENERGY>(&view, pairs[k], &consts[k], h, l);
+        let (pairs, consts) = (&w.pairs.pairs, &w.pairs.consts);
+        let (bounds, pb, cb) = (&self.bounds, &self.pair_bounds, &self.cross_bounds);
+        let (cross, cross_slot, incoming) = (&self.cross, &self.cross_slot, &self.incoming);
+        let threads = &self.threads;
+        {
+            // (1) Each range's cross pairs, into their slots.
+            let parts = cut(&mut w.pairs.hist, pb).into_iter().zip(cut(&mut self.ledgers, &ledger_bounds)).zip(cut(&mut self.cross_out, cb));
+            threads.each(parts.collect(), |r, ((hist, ledgers), out)| {
+                let mut none = EnergyLedger::default();
+                for (s, o) in (cb[r]..cb[r + 1]).zip(out.iter_mut()) {
+                    let k = cross[s] as usize;
+                    let l = if ENERGY { &mut ledgers[k - pb[r]] } else { &mut none };
+                    *o = pair_contact::<Dm, T, ENERGY>(&view, pairs[k], &consts[k], &mut hist[k - pb[r]], l);
+                }
             });
-            let cross_out = &*cross_out;
-            // (2) Each range: incoming cross pairs, then the serial loop over its pairs.
-            let mut f_parts = Vec::new();
-            let mut t_parts = Vec::new();
-            let (mut fr, mut tr) = (&mut f[..], &mut torque[..]);
-            for r in 0..self.threads {
-                let len = bounds[r + 1] - bounds[r];
-                let (a, b) = std::mem::take(&mut fr).split_at_mut(len);
-                let (c, d) = std::mem::take(&mut tr).split_at_mut(len);
-                f_parts.push(a);
-                t_parts.push(c);
-                fr = b;
-                tr = d;
-            }
-            f_parts.into_par_iter().zip(t_parts.into_par_iter()).zip(worsts.par_iter_mut()).enumerate().for_each(|(r, ((fl, tl), worst))| {
-                let g0 = bounds[r];
+            let cross_out = &self.cross_out;
+            // (2) Each range: incoming cross pairs, then its own part of the list.
+            let parts = cut(&mut w.pairs.hist, pb)
+                .into_iter()
+                .zip(cut(&mut self.ledgers, &ledger_bounds))
+                .zip(cut(&mut f, bounds))
+                .zip(cut(&mut torque, bounds))
+                .zip(self.scratch.iter_mut());
+            threads.each(parts.collect(), |r, ((((hist, ledgers), fl), tl), sc)| {
+                let (g0, part) = (bounds[r], pb[r]..pb[r + 1]);
                 for &s in &incoming[r] {
                     let o = &cross_out[s as usize];
                     if o.ratio > 0.0 {
@@ -169,52 +176,55 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
                         }
                     }
                 }
+                sort_pairs(view.p, &view.boundary, &pairs[part.clone()], hist, Some(&cross_slot[part.clone()]), &mut sc.touching, &mut sc.released);
+                let mut none = EnergyLedger::default();
+                let l = if ENERGY { Ledgers::PerPair(ledgers) } else { Ledgers::One(&mut none) };
+                let list = PairSlices::<T> { pairs: &pairs[part.clone()], consts: &consts[part.clone()], hist };
+                compute_pairs::<Dm, T, ENERGY>(&view, list, &sc.touching, &sc.released, l, &mut sc.out);
                 let mut best = (0.0, usize::MAX);
-                for k in first[g0]..first[bounds[r + 1]] {
-                    let pair = pairs[k];
-                    let (i, j) = (pair[0] as usize - g0, pair[1] as usize);
-                    let slot = cross_slot[k];
-                    if slot != NOT_CROSS {
-                        let o = &cross_out[slot as usize];
-                        if o.ratio > 0.0 {
-                            fl[i] += o.force;
-                            if T::FRICTION {
-                                tl[i] -= o.torque[0];
-                            }
-                            if o.ratio > best.0 {
-                                best = (o.ratio, k);
-                            }
-                        }
-                        continue;
+                let mut add = |k: usize, o: &PairOut, own: bool| {
+                    let (i, j) = (pairs[k][0] as usize - g0, pairs[k][1] as usize);
+                    fl[i] += o.force;
+                    if T::FRICTION {
+                        tl[i] -= o.torque[0];
                     }
-                    // SAFETY: pair k's first grain is in this range and it is not a cross
-                    // pair, so no other thread touches its history or ledger.
-                    let h = unsafe { &mut *{ hist }.0.add(k) };
-                    let mut local = EnergyLedger::default();
-                    let l = if ENERGY { unsafe { &mut *{ ledgers }.0.add(k) } } else { &mut local };
-                    let o = pair_contact::<Dm, T, ENERGY>(&view, pair, &consts[k], h, l);
-                    if o.ratio > 0.0 {
-                        let j = j - g0;
-                        fl[i] += o.force;
-                        fl[j] -= o.force;
+                    if own {
+                        fl[j - g0] -= o.force;
                         if T::FRICTION {
-                            tl[i] -= o.torque[0];
-                            tl[j] -= o.torque[1];
+                            tl[j - g0] -= o.torque[1];
                         }
-                        if o.ratio > best.0 {
-                            best = (o.ratio, k);
+                    }
+                    if o.ratio > best.0 {
+                        best = (o.ratio, k);
+                    }
+                };
+                let mut c = cb[r];
+                for (&kk, o) in sc.touching.iter().zip(&sc.out) {
+                    let k = part.start + kk as usize;
+                    while c < cb[r + 1] && (cross[c] as usize) < k {
+                        let oc = &cross_out[c];
+                        if oc.ratio > 0.0 {
+                            add(cross[c] as usize, oc, false);
                         }
+                        c += 1;
+                    }
+                    add(k, o, true);
+                }
+                for c in c..cb[r + 1] {
+                    let oc = &cross_out[c];
+                    if oc.ratio > 0.0 {
+                        add(cross[c] as usize, oc, false);
                     }
                 }
-                *worst = best;
+                sc.worst = best;
             });
-        });
+        }
         w.p.f = f;
         w.p.torque = torque;
         // (3) The largest overlap as the serial loop picks it (the first of equal maxima),
         // and the energy terms in list order.
         let mut best = (0.0, usize::MAX);
-        for &(ratio, k) in &worsts {
+        for &(ratio, k) in self.scratch.iter().map(|s| &s.worst) {
             if k != usize::MAX && (ratio > best.0 || (ratio == best.0 && k < best.1)) {
                 best = (ratio, k);
             }

@@ -3,10 +3,19 @@
 //! A scene without walls has no wall stages, without gravity no gravity stage, without
 //! friction no spin update, without periodicity no wrap; `explain` prints the list.
 
-use crate::contact::{ContactInput, ContactLaw, ContactModel};
+use nalgebra::Vector2;
+use simba::simd::SimdValue;
+
+use crate::boundary::Boundary;
 use crate::contact::damping::Damping;
 use crate::contact::tangential::Tangential;
+use crate::contact::{ContactHistory, ContactInput, ContactLaw, ContactModel, LeverArm};
 use crate::dim::{Vec2, cross};
+use crate::lanes::{LANES, Lanes, Real, gather, gather2, lane2};
+use crate::material::PairMaterial;
+use crate::neighbor::PairConst;
+use crate::observe::energy::EnergyLedger;
+use crate::particles::Particles;
 use crate::error::Error;
 use crate::sim::World;
 use crate::walls::{Control, Surface};
@@ -54,9 +63,7 @@ impl<L: ContactLaw> Stage<L> for PeriodicWrap {
     }
     fn run(&mut self, w: &mut World<L>) -> Result<(), Error> {
         let b = w.boundary;
-        for x in &mut w.p.x {
-            b.wrap(x);
-        }
+        w.threads.split(w.p.x.len(), &mut w.p.x[..], |x| x.iter_mut().for_each(|x| b.wrap(x)));
         Ok(())
     }
 }
@@ -69,7 +76,7 @@ impl<L: ContactLaw> Stage<L> for UpdateNeighbours {
         "Neighbours".into()
     }
     fn run(&mut self, w: &mut World<L>) -> Result<(), Error> {
-        if w.neighbours.needs_rebuild(&w.p.x, &w.boundary) {
+        if w.neighbours.needs_rebuild(&w.p.x, &w.boundary, &w.threads) {
             let pairs = w.neighbours.build(&w.p.x, &w.p.r, w.p.n_free, &w.boundary);
             w.pairs.replace(pairs, &w.p.r, &w.p.m);
         }
@@ -85,9 +92,14 @@ impl<L: ContactLaw> Stage<L> for ClearForces {
         "ClearForces".into()
     }
     fn run(&mut self, w: &mut World<L>) -> Result<(), Error> {
-        w.p.f.iter_mut().for_each(|f| *f = Vec2::zeros());
+        let n = w.p.len();
         if L::Tang::FRICTION {
-            w.p.torque.iter_mut().for_each(|t| *t = 0.0);
+            w.threads.split(n, (&mut w.p.f[..], &mut w.p.torque[..]), |(f, t)| {
+                f.fill(Vec2::zeros());
+                t.fill(0.0);
+            });
+        } else {
+            w.threads.split(n, &mut w.p.f[..], |f| f.fill(Vec2::zeros()));
         }
         w.ledger.begin_step();
         w.max_overlap = (0.0, 0, 0);
@@ -175,16 +187,36 @@ pub struct PairOut {
     pub ratio: f64,
 }
 
+/// The contact input of touching pairs (one, or one per lane) from their separation
+/// `d` (minimum image, i minus j), radii, spins, relative velocity and constants.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn pair_input<R: Real, T: Tangential>(lever: LeverArm, d: Vector2<R>, ri: R, rj: R, wi: R, wj: R, v_rel: Vector2<R>, r_star: R, m_star: R, dt: R) -> ContactInput<R> {
+    let radsum = ri + rj;
+    let r = d.norm_squared().simd_sqrt();
+    let n = d / r;
+    let dn = radsum - r;
+    let spin = if T::FRICTION { lever.arm(ri, dn) * wi + lever.arm(rj, dn) * wj } else { R::zero() };
+    let tangential_scale = if T::FRICTION { lever.translation_scale(radsum, dn) } else { R::one() };
+    ContactInput { n, dn, r_star, m_star, v_rel, spin, dt, tangential_scale }
+}
+
+/// The torques `-a n x Ft` to subtract from grains i and j.
+#[inline(always)]
+fn pair_torque<R: Real>(lever: LeverArm, c: &ContactInput<R>, ft: Vector2<R>, ri: R, rj: R) -> [R; 2] {
+    let t = cross(c.n, ft);
+    [lever.torque_arm(ri, c.dn) * t, lever.torque_arm(rj, c.dn) * t]
+}
+
 /// One pair of the Verlet list: the contact force (touching), the end of a contact
-/// (released), or nothing; history and energy terms updated. Shared by the serial and
-/// the parallel stage, so that both compute the same bits.
+/// (released), or nothing; history and energy terms updated.
 #[inline(always)]
 pub fn pair_contact<Dm: Damping, T: Tangential, const ENERGY: bool>(
     w: &PairView<'_, ContactModel<Dm, T>>,
     pair: [u32; 2],
-    pc: &crate::neighbor::PairConst,
+    pc: &PairConst,
     h: &mut crate::sim::Hist<ContactModel<Dm, T>>,
-    ledger: &mut crate::observe::energy::EnergyLedger,
+    ledger: &mut EnergyLedger,
 ) -> PairOut {
     let model = w.law;
     let lever = model.options.lever_arm;
@@ -203,60 +235,155 @@ pub fn pair_contact<Dm: Damping, T: Tangential, const ENERGY: bool>(
         }
         return PairOut::default();
     }
-    let r = rsq.sqrt();
-    let n = d / r;
-    let dn = radsum - r;
-    let (ai, aj) = if T::FRICTION { (lever.arm(ri, dn), lever.arm(rj, dn)) } else { (0.0, 0.0) };
-    let spin = if T::FRICTION { ai * p.omega[i] + aj * p.omega[j] } else { 0.0 };
-    let tangential_scale = if T::FRICTION { lever.translation_scale(radsum, dn) } else { 1.0 };
-    let input = ContactInput { n, dn, r_star: pc.r_star, m_star: pc.m_star, v_rel: p.v[i] - p.v[j], spin, dt: w.dt, tangential_scale };
+    let input = pair_input::<f64, T>(lever, d, ri, rj, p.omega[i], p.omega[j], p.v[i] - p.v[j], pc.r_star, pc.m_star, w.dt);
     let pm = w.pair_table.get(p.material[i] as usize, p.material[j] as usize);
     let c = model.touch::<ENERGY>(&input, pm, h, ledger);
-    let torque = if T::FRICTION {
-        let t = cross(n, c.tangential);
-        [lever.torque_arm(ri, dn) * t, lever.torque_arm(rj, dn) * t]
-    } else {
-        [0.0, 0.0]
-    };
-    PairOut { force: c.force, torque, ratio: dn * pc.inv_r_min }
+    let torque = if T::FRICTION { pair_torque(lever, &input, c.tangential, ri, rj) } else { [0.0, 0.0] };
+    PairOut { force: c.force, torque, ratio: input.dn * pc.inv_r_min }
+}
+
+/// Four touching pairs at once, one per SIMD lane (`ks`: their indices in the list);
+/// the same bits as [`pair_contact`] gives each of them, without the energy ledger.
+#[inline(always)]
+fn four_pairs<Dm: Damping, T: Tangential>(w: &PairView<'_, ContactModel<Dm, T>>, list: PairSlices<'_, T>, ks: &[u32], out: &mut [PairOut]) {
+    let (model, p) = (w.law, w.p);
+    let lever = model.options.lever_arm;
+    let ij: [(usize, usize); LANES] = std::array::from_fn(|l| {
+        let q = list.pairs[ks[l] as usize];
+        (q[0] as usize, q[1] as usize)
+    });
+    let pc: [&PairConst; LANES] = std::array::from_fn(|l| &list.consts[ks[l] as usize]);
+    let d = gather2(|l| w.boundary.image(p.x[ij[l].0] - p.x[ij[l].1]));
+    let (ri, rj) = (gather(|l| p.r[ij[l].0]), gather(|l| p.r[ij[l].1]));
+    let (wi, wj) = if T::FRICTION { (gather(|l| p.omega[ij[l].0]), gather(|l| p.omega[ij[l].1])) } else { (Lanes::splat(0.0), Lanes::splat(0.0)) };
+    let v_rel = gather2(|l| p.v[ij[l].0] - p.v[ij[l].1]);
+    let input = pair_input::<Lanes, T>(lever, d, ri, rj, wi, wj, v_rel, gather(|l| pc[l].r_star), gather(|l| pc[l].m_star), Lanes::splat(w.dt));
+    let pm = PairMaterial::gather(std::array::from_fn(|l| w.pair_table.get(p.material[ij[l].0] as usize, p.material[ij[l].1] as usize)));
+    let mut h = T::gather(std::array::from_fn(|l| &list.hist[ks[l] as usize].tangential));
+    let c = model.force(&input, &pm, &mut h);
+    let torque = if T::FRICTION { pair_torque(lever, &input, c.tangential.elastic + c.tangential.damping, ri, rj) } else { [Lanes::splat(0.0); 2] };
+    let ratio = input.dn * gather(|l| pc[l].inv_r_min);
+    for l in 0..LANES {
+        let hk = &mut list.hist[ks[l] as usize];
+        hk.tangential = T::lane(&h, l);
+        hk.active = true;
+        out[l] = PairOut { force: lane2(&c.force, l), torque: [torque[0].extract(l), torque[1].extract(l)], ratio: ratio.extract(l) };
+    }
+}
+
+/// A part of the pair list: the pairs, their constants and histories.
+pub struct PairSlices<'a, T: Tangential> {
+    pub pairs: &'a [[u32; 2]],
+    pub consts: &'a [PairConst],
+    pub hist: &'a mut [ContactHistory<T::History<f64>>],
+}
+
+/// Where the energy terms of the pairs go: the world's ledger (serial order), or one
+/// ledger per pair of the list part (merged in list order later).
+pub enum Ledgers<'a> {
+    One(&'a mut EnergyLedger),
+    PerPair(&'a mut [EnergyLedger]),
+}
+
+impl Ledgers<'_> {
+    #[inline(always)]
+    fn get(&mut self, k: usize) -> &mut EnergyLedger {
+        match self {
+            Ledgers::One(l) => l,
+            Ledgers::PerPair(v) => &mut v[k],
+        }
+    }
+}
+
+/// The pairs of a list part that are touching (`touching`), and those that were at the
+/// previous step and are not any more (`released`), as indices into the part, in list
+/// order; `skip` (if given) leaves out pairs computed elsewhere. No branch per pair.
+pub fn sort_pairs<H>(p: &Particles, boundary: &Boundary, pairs: &[[u32; 2]], hist: &[ContactHistory<H>], skip: Option<&[u32]>, touching: &mut Vec<u32>, released: &mut Vec<u32>) {
+    touching.clear();
+    released.clear();
+    touching.resize(pairs.len(), 0);
+    released.resize(pairs.len(), 0);
+    let (mut nt, mut nr) = (0, 0);
+    for (k, (pair, h)) in pairs.iter().zip(hist).enumerate() {
+        let (i, j) = (pair[0] as usize, pair[1] as usize);
+        let d = boundary.image(p.x[i] - p.x[j]);
+        let radsum = p.r[i] + p.r[j];
+        let mine = skip.is_none_or(|s| s[k] == u32::MAX);
+        let touch = d.norm_squared() < radsum * radsum;
+        touching[nt] = k as u32;
+        released[nr] = k as u32;
+        nt += (touch & mine) as usize;
+        nr += (!touch & h.active & mine) as usize;
+    }
+    touching.truncate(nt);
+    released.truncate(nr);
+}
+
+/// Compute the pairs `touching` and `released` of a list part (indices from
+/// [`sort_pairs`]): their outputs, in list order, go to `out` (`out[m]` for
+/// `order[m]`); `order` lists both kinds merged in list order. Without the energy
+/// ledger the touching pairs run four at a time in SIMD lanes; with it, one by one in
+/// list order, so that the ledger sums in the serial order.
+pub fn compute_pairs<Dm: Damping, T: Tangential, const ENERGY: bool>(
+    w: &PairView<'_, ContactModel<Dm, T>>,
+    list: PairSlices<'_, T>,
+    touching: &[u32],
+    released: &[u32],
+    mut ledgers: Ledgers<'_>,
+    out: &mut Vec<PairOut>,
+) {
+    let PairSlices { pairs, consts, hist } = list;
+    out.clear();
+    if ENERGY {
+        // Both kinds merged in list order: the ledger is a sum.
+        let (mut a, mut b) = (0, 0);
+        while a < touching.len() || b < released.len() {
+            let touch = b == released.len() || (a < touching.len() && touching[a] < released[b]);
+            let k = if touch { touching[a] } else { released[b] } as usize;
+            let o = pair_contact::<Dm, T, ENERGY>(w, pairs[k], &consts[k], &mut hist[k], ledgers.get(k));
+            if touch {
+                out.push(o);
+                a += 1;
+            } else {
+                b += 1;
+            }
+        }
+        return;
+    }
+    out.resize(touching.len(), PairOut::default());
+    let quads = touching.len() / LANES * LANES;
+    for (ks, o) in touching[..quads].chunks_exact(LANES).zip(out.chunks_exact_mut(LANES)) {
+        four_pairs(w, PairSlices::<T> { pairs, consts, hist: &mut *hist }, ks, o);
+    }
+    let mut none = EnergyLedger::default();
+    for (m, &k) in touching.iter().enumerate().skip(quads) {
+        let k = k as usize;
+        out[m] = pair_contact::<Dm, T, false>(w, pairs[k], &consts[k], &mut hist[k], &mut none);
+    }
+    for &k in released {
+        let k = k as usize;
+        pair_contact::<Dm, T, false>(w, pairs[k], &consts[k], &mut hist[k], &mut none);
+    }
 }
 
 /// What the pair kernel reads: everything but the forces it produces.
 pub struct PairView<'a, L: ContactLaw> {
-    pub p: &'a crate::particles::Particles,
-    pub boundary: crate::boundary::Boundary,
+    pub p: &'a Particles,
+    pub boundary: Boundary,
     pub law: L,
     pub pair_table: &'a crate::material::PairTable,
     pub dt: f64,
 }
 
-/// Grain-grain contacts over the Verlet list, in two passes: a branch-free sweep picks
-/// the pairs that need the kernel (touching now, or touching at the previous step), then
-/// the kernel runs over those only, in list order. Most listed pairs are not touching
-/// (the skin): the sweep spares them the kernel's mispredicted branch.
+/// Grain-grain contacts over the Verlet list, in two passes: a branch-free sweep sorts
+/// out the pairs that are touching (and those just released), then the kernel runs on
+/// those only, four at a time in SIMD lanes. Most listed pairs are not touching (the
+/// skin): the sweep spares them the kernel.
 #[derive(Default)]
 pub struct PairForces<const ENERGY: bool> {
-    /// Indices into the pair list of the pairs this step works on.
-    work: Vec<u32>,
-}
-
-/// The pairs of `pairs[range]` that are touching or were touching at the previous step,
-/// as indices into `pairs`, appended to `work` in list order. No branch per pair.
-#[inline(never)]
-pub fn pairs_in_contact<H>(p: &crate::particles::Particles, boundary: &crate::boundary::Boundary, pairs: &[[u32; 2]], hist: &[crate::contact::ContactHistory<H>], range: std::ops::Range<usize>, work: &mut Vec<u32>) {
-    let start = work.len();
-    work.resize(start + range.len(), 0);
-    let mut count = start;
-    for k in range {
-        let pair = pairs[k];
-        let (i, j) = (pair[0] as usize, pair[1] as usize);
-        let d = boundary.image(p.x[i] - p.x[j]);
-        let radsum = p.r[i] + p.r[j];
-        let keep = (d.norm_squared() < radsum * radsum) | hist[k].active;
-        work[count] = k as u32;
-        count += keep as usize;
-    }
-    work.truncate(count);
+    touching: Vec<u32>,
+    released: Vec<u32>,
+    out: Vec<PairOut>,
 }
 
 impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> for PairForces<ENERGY> {
@@ -267,27 +394,22 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
         let mut worst = w.max_overlap;
         let mut f = std::mem::take(&mut w.p.f);
         let mut torque = std::mem::take(&mut w.p.torque);
-        let pairs = &w.pairs.pairs;
-        self.work.clear();
-        pairs_in_contact(&w.p, &w.boundary, pairs, &w.pairs.hist, 0..pairs.len(), &mut self.work);
-        {
-            let view = PairView { p: &w.p, boundary: w.boundary, law: w.law, pair_table: &w.pair_table, dt: w.dt };
-            let (consts, hist) = (&w.pairs.consts, &mut w.pairs.hist);
-            for &k in &self.work {
-                let (pair, k) = (pairs[k as usize], k as usize);
-                let o = pair_contact::<Dm, T, ENERGY>(&view, pair, &consts[k], &mut hist[k], &mut w.ledger);
-                if o.ratio > 0.0 {
-                    let (i, j) = (pair[0] as usize, pair[1] as usize);
-                    f[i] += o.force;
-                    f[j] -= o.force;
-                    if T::FRICTION {
-                        torque[i] -= o.torque[0];
-                        torque[j] -= o.torque[1];
-                    }
-                    if o.ratio > worst.0 {
-                        worst = (o.ratio, i, j);
-                    }
-                }
+        let (pairs, consts) = (&w.pairs.pairs, &w.pairs.consts);
+        sort_pairs(&w.p, &w.boundary, pairs, &w.pairs.hist, None, &mut self.touching, &mut self.released);
+        let view = PairView { p: &w.p, boundary: w.boundary, law: w.law, pair_table: &w.pair_table, dt: w.dt };
+        let list = PairSlices::<T> { pairs, consts, hist: &mut w.pairs.hist };
+        compute_pairs::<Dm, T, ENERGY>(&view, list, &self.touching, &self.released, Ledgers::One(&mut w.ledger), &mut self.out);
+        for (&k, o) in self.touching.iter().zip(&self.out) {
+            let pair = pairs[k as usize];
+            let (i, j) = (pair[0] as usize, pair[1] as usize);
+            f[i] += o.force;
+            f[j] -= o.force;
+            if T::FRICTION {
+                torque[i] -= o.torque[0];
+                torque[j] -= o.torque[1];
+            }
+            if o.ratio > worst.0 {
+                worst = (o.ratio, i, j);
             }
         }
         w.p.f = f;

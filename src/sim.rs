@@ -15,7 +15,7 @@ use crate::pipeline::Stage;
 use crate::walls::Wall;
 
 /// History type of a contact law.
-pub type Hist<L> = ContactHistory<<<L as ContactLaw>::Tang as Tangential>::History>;
+pub type Hist<L> = ContactHistory<<<L as ContactLaw>::Tang as Tangential>::History<f64>>;
 
 /// Everything that evolves.
 pub struct World<L: ContactLaw> {
@@ -25,7 +25,7 @@ pub struct World<L: ContactLaw> {
     pub pair_table: PairTable,
     /// Material index of flat walls.
     pub wall_material: usize,
-    pub pairs: PairList<<L::Tang as Tangential>::History>,
+    pub pairs: PairList<<L::Tang as Tangential>::History<f64>>,
     pub walls: Vec<Wall>,
     /// History of each free grain against each flat wall: `wall_hist[wall][grain]`.
     pub wall_hist: Vec<Vec<Hist<L>>>,
@@ -42,6 +42,8 @@ pub struct World<L: ContactLaw> {
     pub initial_energy: f64,
     /// The energy ledger is kept (the kernels were compiled with it).
     pub energy: bool,
+    /// The threads the per-grain stages and the contact stage may use.
+    pub threads: crate::threads::Threads,
 }
 
 impl<L: ContactLaw> World<L> {

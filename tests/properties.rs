@@ -1,4 +1,5 @@
-//! Property tests: the cell list finds exactly the pairs brute force finds.
+//! Property tests: the cell list finds exactly the pairs brute force finds, and the
+//! four-lane contact kernel gives each contact the bits the one-contact kernel gives it.
 
 use grainlab::boundary::Boundary;
 use grainlab::dim::Vec2;
@@ -29,5 +30,86 @@ proptest! {
         let brute = brute_force_pairs(&x, &r, n_free, &b, skin);
         let cells = cell_pairs(&x, &r, n_free, &b, skin, &mut Vec::new(), &mut Vec::new());
         prop_assert_eq!(cells, brute);
+    }
+}
+
+/// One contact's random state: overlap, normal angle, velocities, spin, history.
+fn contact() -> impl Strategy<Value = [f64; 9]> {
+    // Overlaps from 1e-9 to 1e-4 of a 0.5 mm grain; speeds up to 1 m/s; the history
+    // from nothing to beyond the Coulomb cap, so that lanes mix sticking and sliding.
+    (-9.0f64..-4.0, 0.0f64..6.3, -1.0f64..1.0, -1.0f64..1.0, -1.0f64..1.0, -1e-5f64..1e-5, -1e-5f64..1e-5, 0.0f64..6.3, 0.2f64..1.0)
+        .prop_map(|(dn, a, vx, vy, w, hx, hy, b, rs)| [10f64.powf(dn) * 5e-4, a, vx, vy, 1e3 * w, hx, hy, b, rs])
+}
+
+fn lanes_match_alone<T: grainlab::contact::tangential::Tangential>(
+    cs: &[[f64; 9]; 4],
+    limit_force: bool,
+    lever_arm: grainlab::contact::LeverArm,
+    hist: impl Fn(&[f64; 9]) -> T::History<f64>,
+    bits: impl Fn(&T::History<f64>) -> Vec<u64>,
+) -> Result<(), TestCaseError> {
+    use grainlab::contact::damping::Viscoelastic;
+    use grainlab::contact::{ContactInput, ContactModel, ModelOptions};
+    use grainlab::lanes::{Lanes, gather, gather2, lane2};
+    use grainlab::material::{Material, PairMaterial};
+    use simba::simd::SimdValue;
+    let model = ContactModel::<Viscoelastic, T>::new(ModelOptions { limit_force, lever_arm });
+    let pm = PairMaterial::mix(&Material::default(), &Material::default());
+    let input = |c: &[f64; 9]| ContactInput {
+        n: Vec2::new(c[1].cos(), c[1].sin()),
+        dn: c[0],
+        r_star: 2.5e-4 * c[8],
+        m_star: 6.5e-7 * c[8],
+        v_rel: Vec2::new(c[2], c[3]),
+        spin: 2.5e-4 * c[4],
+        dt: 5.8e-8,
+        tangential_scale: 1.0 + c[0] / 5e-4,
+    };
+    let alone: Vec<_> = cs.iter().map(|c| {
+        let mut h = hist(c);
+        let s = model.force(&input(c), &pm, &mut h);
+        (s, h)
+    }).collect();
+    let one: Vec<_> = cs.iter().map(input).collect();
+    let lanes = ContactInput {
+        n: gather2(|l| one[l].n),
+        dn: gather(|l| one[l].dn),
+        r_star: gather(|l| one[l].r_star),
+        m_star: gather(|l| one[l].m_star),
+        v_rel: gather2(|l| one[l].v_rel),
+        spin: gather(|l| one[l].spin),
+        dt: Lanes::splat(5.8e-8),
+        tangential_scale: gather(|l| one[l].tangential_scale),
+    };
+    let hs: Vec<_> = cs.iter().map(&hist).collect();
+    let mut h = T::gather([&hs[0], &hs[1], &hs[2], &hs[3]]);
+    let s = model.force(&lanes, &PairMaterial::gather([&pm; 4]), &mut h);
+    for l in 0..4 {
+        let f = lane2(&s.force, l);
+        prop_assert_eq!(f.x.to_bits(), alone[l].0.force.x.to_bits(), "lane {} force x", l);
+        prop_assert_eq!(f.y.to_bits(), alone[l].0.force.y.to_bits(), "lane {} force y", l);
+        prop_assert_eq!(s.normal.extract(l).to_bits(), alone[l].0.normal.to_bits());
+        prop_assert_eq!(bits(&T::lane(&h, l)), bits(&alone[l].1), "lane {} history", l);
+    }
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(300))]
+    #[test]
+    fn four_lanes_give_each_contact_its_own_bits(c0 in contact(), c1 in contact(), c2 in contact(), c3 in contact(), clamp in any::<bool>(), lever in 0usize..3) {
+        use grainlab::contact::LeverArm;
+        use grainlab::contact::tangential::{IncrementalForce, IncrementalState, TotalDisplacement};
+        let lever = [LeverArm::Radius, LeverArm::RadiusMinusHalfOverlap, LeverArm::Yade][lever];
+        let cs = [c0, c1, c2, c3];
+        let v = |v: &Vec2| vec![v.x.to_bits(), v.y.to_bits()];
+        lanes_match_alone::<TotalDisplacement>(&cs, clamp, lever, |c| Vec2::new(c[5], c[6]), v)?;
+        lanes_match_alone::<IncrementalForce>(
+            &cs,
+            clamp,
+            lever,
+            |c| IncrementalState { force: Vec2::new(c[5], c[6]) * 1e3, n_prev: Vec2::new(c[7].cos(), c[7].sin()) },
+            |h| [v(&h.force), v(&h.n_prev)].concat(),
+        )?;
     }
 }

@@ -6,11 +6,13 @@
 //! relative velocity. [`Undamped`] is what a scene with e = 1 everywhere gets: no
 //! coefficients are computed at all.
 
+use crate::lanes::{Real, k};
+
 /// How the damping coefficients follow from the stiffnesses.
 pub trait Damping: Copy + Default + Send + Sync + 'static {
     const NAME: &'static str;
     /// `(gn, gt)`, kg/s, from `beta`, the tangent stiffnesses `Sn`, `St` (N/m) and `m*` (kg).
-    fn coefficients(beta: f64, sn: f64, st: f64, m_star: f64) -> (f64, f64);
+    fn coefficients<R: Real>(beta: R, sn: R, st: R, m_star: R) -> (R, R);
 }
 
 /// sqrt(5/6).
@@ -22,9 +24,9 @@ pub struct Viscoelastic;
 impl Damping for Viscoelastic {
     const NAME: &'static str = "Viscoelastic";
     #[inline(always)]
-    fn coefficients(beta: f64, sn: f64, st: f64, m_star: f64) -> (f64, f64) {
-        let c = -2.0 * SQRT_FIVE_SIXTHS * beta;
-        (c * (sn * m_star).sqrt(), c * (st * m_star).sqrt())
+    fn coefficients<R: Real>(beta: R, sn: R, st: R, m_star: R) -> (R, R) {
+        let c = k::<R>(-2.0 * SQRT_FIVE_SIXTHS) * beta;
+        (c * (sn * m_star).simd_sqrt(), c * (st * m_star).simd_sqrt())
     }
 }
 
@@ -34,7 +36,7 @@ pub struct Undamped;
 impl Damping for Undamped {
     const NAME: &'static str = "Undamped";
     #[inline(always)]
-    fn coefficients(_: f64, _: f64, _: f64, _: f64) -> (f64, f64) {
-        (0.0, 0.0)
+    fn coefficients<R: Real>(_: R, _: R, _: R, _: R) -> (R, R) {
+        (R::zero(), R::zero())
     }
 }

@@ -5,10 +5,13 @@ use std::marker::PhantomData;
 
 use serde::{Deserialize, Serialize};
 
+use nalgebra::Vector2;
+
 use super::damping::{Damping, Undamped, Viscoelastic};
 use super::normal::{HertzStiffness, hertz_energy};
-use super::tangential::{Frictionless, IncrementalForce, Tangential, TangentialInput, TotalDisplacement};
+use super::tangential::{Frictionless, IncrementalForce, Tangential, TangentialForce, TangentialInput, TotalDisplacement};
 use crate::dim::Vec2;
+use crate::lanes::{Real, k, pick};
 use crate::material::PairMaterial;
 use crate::observe::energy::EnergyLedger;
 
@@ -34,18 +37,18 @@ pub enum LeverArm {
 impl LeverArm {
     /// The arm of the spin in the contact-point velocity, m.
     #[inline(always)]
-    pub fn arm(self, r: f64, dn: f64) -> f64 {
+    pub fn arm<R: Real>(self, r: R, dn: R) -> R {
         match self {
             LeverArm::Radius | LeverArm::Yade => r,
-            LeverArm::RadiusMinusHalfOverlap => r - 0.5 * dn,
+            LeverArm::RadiusMinusHalfOverlap => r - k::<R>(0.5) * dn,
         }
     }
     /// The torque arm of a grain-grain contact, m.
     #[inline(always)]
-    pub fn torque_arm(self, r: f64, dn: f64) -> f64 {
+    pub fn torque_arm<R: Real>(self, r: R, dn: R) -> R {
         match self {
             LeverArm::Radius => r,
-            LeverArm::RadiusMinusHalfOverlap | LeverArm::Yade => r - 0.5 * dn,
+            LeverArm::RadiusMinusHalfOverlap | LeverArm::Yade => r - k::<R>(0.5) * dn,
         }
     }
     /// The torque arm of a grain on a flat wall, m.
@@ -58,10 +61,10 @@ impl LeverArm {
     }
     /// Factor on the translational part of the tangential velocity of a pair.
     #[inline(always)]
-    pub fn translation_scale(self, radsum: f64, dn: f64) -> f64 {
+    pub fn translation_scale<R: Real>(self, radsum: R, dn: R) -> R {
         match self {
             LeverArm::Yade => radsum / (radsum - dn),
-            _ => 1.0,
+            _ => R::one(),
         }
     }
 }
@@ -74,34 +77,54 @@ pub struct ModelOptions {
     pub lever_arm: LeverArm,
 }
 
-/// What the kernel needs of one touching pair (or grain and wall) at one step.
+/// What the kernel needs of one touching pair (or grain and wall) at one step; with
+/// `R = Lanes`, of four pairs.
 #[derive(Clone, Copy, Debug)]
-pub struct ContactInput {
+pub struct ContactInput<R: Real = f64> {
     /// Unit normal from j to i (from the wall into grain i).
-    pub n: Vec2,
+    pub n: Vector2<R>,
     /// Overlap dn > 0, m.
-    pub dn: f64,
+    pub dn: R,
     /// Reduced radius R*, m.
-    pub r_star: f64,
+    pub r_star: R,
     /// Reduced mass m*, kg.
-    pub m_star: f64,
+    pub m_star: R,
     /// v_i - v_j at the centres, m/s.
-    pub v_rel: Vec2,
+    pub v_rel: Vector2<R>,
     /// a_i w_i + a_j w_j: the spin part of the contact-point velocity, m/s.
-    pub spin: f64,
+    pub spin: R,
     /// Time step, s.
-    pub dt: f64,
+    pub dt: R,
     /// Factor on the translational part of the tangential velocity (1, except for YADE's
     /// ratcheting correction, [`LeverArm::translation_scale`]).
-    pub tangential_scale: f64,
+    pub tangential_scale: R,
 }
 
-impl ContactInput {
+impl<R: Real> ContactInput<R> {
     /// Relative velocity of the contact points, i relative to j.
     #[inline(always)]
-    pub fn contact_velocity(&self) -> Vec2 {
-        self.v_rel + self.spin * Vec2::new(self.n.y, -self.n.x)
+    pub fn contact_velocity(&self) -> Vector2<R> {
+        self.v_rel + Vector2::new(self.n.y, -self.n.x) * self.spin
     }
+}
+
+/// Everything one step of a touching contact computes: the force, and what the energy
+/// accounting reads.
+#[derive(Clone, Copy, Debug)]
+pub struct ContactState<R: Real = f64> {
+    /// Total force on i, N.
+    pub force: Vector2<R>,
+    /// Tangential force on i, elastic and viscous parts.
+    pub tangential: TangentialForce<R>,
+    /// Normal force along n (after the clamp, if any), N.
+    pub normal: R,
+    /// Elastic part of the normal force, kn dn, N.
+    pub elastic_normal: R,
+    /// Normal and tangential stiffness, N/m.
+    pub kn: R,
+    pub kt: R,
+    /// Relative velocity of the contact points, m/s.
+    pub vc: Vector2<R>,
 }
 
 /// The force of one contact on grain i (grain j gets the opposite).
@@ -169,6 +192,34 @@ impl<Dm: Damping, T: Tangential> ContactModel<Dm, T> {
         ContactModel { options, _p: PhantomData }
     }
 
+    /// The force of a touching contact (of four, one per lane, with `R = Lanes`),
+    /// advancing its tangential state. No branch on the data: the same bits per lane as
+    /// for the contact alone.
+    #[inline(always)]
+    pub fn force<R: Real>(&self, c: &ContactInput<R>, pm: &PairMaterial<R>, h: &mut T::History<R>) -> ContactState<R> {
+        let st = HertzStiffness::new(pm.e_star, pm.g_star, c.r_star, c.dn);
+        let (gn, gt) = Dm::coefficients(pm.beta, st.sn, st.kt, c.m_star);
+        let vc = c.contact_velocity();
+        let vn = vc.dot(&c.n);
+        let elastic_n = st.kn * c.dn;
+        let mut fnorm = elastic_n - gn * vn;
+        if self.options.limit_force {
+            fnorm = pick(fnorm.simd_lt(R::zero()), R::zero(), fnorm);
+        }
+        let mut force = c.n * fnorm;
+        let mut tf = TangentialForce::default();
+        if T::FRICTION {
+            let mut vt = vc - c.n * vn;
+            if self.options.lever_arm == LeverArm::Yade {
+                vt += (c.v_rel - c.n * c.v_rel.dot(&c.n)) * (c.tangential_scale - R::one());
+            }
+            let inp = TangentialInput { n: c.n, vt, kt: st.kt, gt, cap: pm.friction * fnorm.simd_abs(), dt: c.dt };
+            tf = T::force(h, &inp);
+        }
+        force += tf.elastic + tf.damping;
+        ContactState { force, tangential: tf, normal: fnorm, elastic_normal: elastic_n, kn: st.kn, kt: st.kt, vc }
+    }
+
     /// The force of a touching contact, updating its history; with `ENERGY`, the
     /// trapezoidal work integrals of this step go into `ledger`.
     #[inline(always)]
@@ -176,37 +227,18 @@ impl<Dm: Damping, T: Tangential> ContactModel<Dm, T> {
         &self,
         c: &ContactInput,
         pm: &PairMaterial,
-        h: &mut ContactHistory<T::History>,
+        h: &mut ContactHistory<T::History<f64>>,
         ledger: &mut EnergyLedger,
     ) -> ContactForce {
-        let st = HertzStiffness::new(pm.e_star, pm.g_star, c.r_star, c.dn);
-        let (gn, gt) = Dm::coefficients(pm.beta, st.sn, st.kt, c.m_star);
-        let vc = c.contact_velocity();
-        let vn = vc.dot(&c.n);
-        let elastic_n = st.kn * c.dn;
-        let mut fnorm = elastic_n - gn * vn;
-        if self.options.limit_force && fnorm < 0.0 {
-            fnorm = 0.0;
-        }
-        let mut force = fnorm * c.n;
-        let mut tf = Default::default();
-        if T::FRICTION {
-            let mut vt = vc - vn * c.n;
-            if c.tangential_scale != 1.0 {
-                vt += (c.tangential_scale - 1.0) * (c.v_rel - c.v_rel.dot(&c.n) * c.n);
-            }
-            let inp = TangentialInput { n: c.n, vt, kt: st.kt, gt, cap: pm.friction * fnorm.abs(), dt: c.dt };
-            tf = T::force(&mut h.tangential, &inp);
-        }
-        let ft: Vec2 = tf.elastic + tf.damping;
-        force += ft;
+        let s = self.force(c, pm, &mut h.tangential);
+        let tf = s.tangential;
         if ENERGY {
-            let dc = vc * c.dt;
-            let fd = fnorm - elastic_n;
+            let dc = s.vc * c.dt;
+            let fd = s.normal - s.elastic_normal;
             ledger.normal_damping -= 0.5 * (h.fd_prev + fd) * dc.dot(&c.n);
-            ledger.elastic_normal += hertz_energy(st.kn, c.dn);
+            ledger.elastic_normal += hertz_energy(s.kn, c.dn);
             if T::FRICTION {
-                let ut = if st.kt > 0.0 { 0.5 * tf.elastic.norm_squared() / st.kt } else { 0.0 };
+                let ut = if s.kt > 0.0 { 0.5 * tf.elastic.norm_squared() / s.kt } else { 0.0 };
                 ledger.tangential_damping -= 0.5 * (h.ftd_prev + tf.damping).dot(&dc);
                 let w_spring = 0.5 * (h.fte_prev + tf.elastic).dot(&dc);
                 ledger.friction += tf.slip_energy;
@@ -219,13 +251,13 @@ impl<Dm: Damping, T: Tangential> ContactModel<Dm, T> {
             h.fd_prev = fd;
         }
         h.active = true;
-        ContactForce { force, tangential: ft, normal: fnorm, kn: st.kn }
+        ContactForce { force: s.force, tangential: tf.elastic + tf.damping, normal: s.normal, kn: s.kn }
     }
 
     /// A contact that was touching at the previous step and is not any more: close its
     /// energy integrals (the force fell to zero over this step) and forget its history.
     #[inline(always)]
-    pub fn release<const ENERGY: bool>(&self, c_velocity: Vec2, n: Vec2, dt: f64, h: &mut ContactHistory<T::History>, ledger: &mut EnergyLedger) {
+    pub fn release<const ENERGY: bool>(&self, c_velocity: Vec2, n: Vec2, dt: f64, h: &mut ContactHistory<T::History<f64>>, ledger: &mut EnergyLedger) {
         if ENERGY {
             let dc = c_velocity * dt;
             ledger.normal_damping -= 0.5 * h.fd_prev * dc.dot(&n);

@@ -4,24 +4,26 @@
 //! (tangent stiffness dF/d dn), `kt = St = 8 G* sqrt(R* dn)` (Mindlin's tangential
 //! stiffness without micro-slip).
 
-/// Stiffnesses of one Hertz contact at overlap `dn`.
+use crate::lanes::{Real, k};
+
+/// Stiffnesses of one Hertz contact at overlap `dn` (or of one contact per lane).
 #[derive(Clone, Copy, Debug)]
-pub struct HertzStiffness {
+pub struct HertzStiffness<R = f64> {
     /// Normal secant stiffness kn, N/m.
-    pub kn: f64,
+    pub kn: R,
     /// Normal tangent stiffness Sn, N/m.
-    pub sn: f64,
+    pub sn: R,
     /// Tangential stiffness kt = St, N/m.
-    pub kt: f64,
+    pub kt: R,
 }
 
-impl HertzStiffness {
+impl<R: Real> HertzStiffness<R> {
     #[inline(always)]
-    pub fn new(e_star: f64, g_star: f64, r_star: f64, dn: f64) -> Self {
-        let sqrtval = (r_star * dn).sqrt();
-        let sn = 2.0 * e_star * sqrtval;
-        let kt = 8.0 * g_star * sqrtval;
-        HertzStiffness { kn: 4.0 / 3.0 * e_star * sqrtval, sn, kt }
+    pub fn new(e_star: R, g_star: R, r_star: R, dn: R) -> Self {
+        let sqrtval = (r_star * dn).simd_sqrt();
+        let sn = k::<R>(2.0) * e_star * sqrtval;
+        let kt = k::<R>(8.0) * g_star * sqrtval;
+        HertzStiffness { kn: k::<R>(4.0 / 3.0) * e_star * sqrtval, sn, kt }
     }
 }
 

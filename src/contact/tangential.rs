@@ -5,44 +5,53 @@
 //! damping coefficient `gt` (kg/s), the Coulomb cap `mu |Fn|` (N) and the time step, and
 //! returns the elastic and the damping part of the tangential force on grain i.
 
-use crate::dim::{Vec2, cross};
+use nalgebra::Vector2;
 
-/// What a tangential formulation needs of one contact at one step.
+use crate::dim::cross;
+use crate::lanes::{Real, k, pick, pick2};
+
+/// What a tangential formulation needs of one contact (or one per lane) at one step.
 #[derive(Clone, Copy, Debug)]
-pub struct TangentialInput {
+pub struct TangentialInput<R: Real = f64> {
     /// Unit normal, from j to i.
-    pub n: Vec2,
+    pub n: Vector2<R>,
     /// Tangential relative velocity of the contact points (i relative to j), m/s.
-    pub vt: Vec2,
+    pub vt: Vector2<R>,
     /// Tangential stiffness, N/m.
-    pub kt: f64,
+    pub kt: R,
     /// Tangential damping coefficient, kg/s.
-    pub gt: f64,
+    pub gt: R,
     /// Coulomb cap mu |Fn|, N.
-    pub cap: f64,
+    pub cap: R,
     /// Time step, s.
-    pub dt: f64,
+    pub dt: R,
 }
 
 /// The tangential force on grain i, split for the energy balance.
 #[derive(Clone, Copy, Debug, Default)]
-pub struct TangentialForce {
+pub struct TangentialForce<R: Real = f64> {
     /// Elastic (spring) part, N.
-    pub elastic: Vec2,
+    pub elastic: Vector2<R>,
     /// Viscous part, N.
-    pub damping: Vec2,
+    pub damping: Vector2<R>,
     /// Elastic energy removed from the spring by sliding at this step, J.
-    pub slip_energy: f64,
+    pub slip_energy: R,
 }
 
-/// A tangential formulation.
+/// A tangential formulation, written once for one contact (`R = f64`) and for four
+/// contacts in lanes (`R = Lanes`), without branches on the data: sliding or sticking
+/// is a select.
 pub trait Tangential: Copy + Default + Send + Sync + 'static {
     const NAME: &'static str;
     /// False for frictionless contacts: no tangential force, no torque, no spin.
     const FRICTION: bool;
-    /// The state a contact carries from step to step.
-    type History: Copy + Default + Send + Sync + std::fmt::Debug;
-    fn force(h: &mut Self::History, inp: &TangentialInput) -> TangentialForce;
+    /// The state a contact carries from step to step (one per lane with `R = Lanes`).
+    type History<R: Real>: Copy + Default + Send + Sync + std::fmt::Debug;
+    fn force<R: Real>(h: &mut Self::History<R>, inp: &TangentialInput<R>) -> TangentialForce<R>;
+    /// Four contacts' states in lanes.
+    fn gather(h: [&Self::History<f64>; crate::lanes::LANES]) -> Self::History<crate::lanes::Lanes>;
+    /// Lane `l` of a state in lanes.
+    fn lane(h: &Self::History<crate::lanes::Lanes>, l: usize) -> Self::History<f64>;
 }
 
 /// No tangential force at all.
@@ -52,11 +61,15 @@ pub struct Frictionless;
 impl Tangential for Frictionless {
     const NAME: &'static str = "Frictionless";
     const FRICTION: bool = false;
-    type History = ();
+    type History<R: Real> = ();
     #[inline(always)]
-    fn force(_: &mut (), _: &TangentialInput) -> TangentialForce {
+    fn force<R: Real>(_: &mut (), _: &TangentialInput<R>) -> TangentialForce<R> {
         TangentialForce::default()
     }
+    #[inline(always)]
+    fn gather(_: [&(); crate::lanes::LANES]) {}
+    #[inline(always)]
+    fn lane(_: &(), _: usize) {}
 }
 
 /// LIGGGHTS `tangential history`: a total tangential displacement `xi`, advanced by
@@ -70,36 +83,43 @@ impl Tangential for TotalDisplacement {
     const NAME: &'static str = "TotalDisplacementHistory";
     const FRICTION: bool = true;
     /// The tangential displacement xi, m.
-    type History = Vec2;
+    type History<R: Real> = Vector2<R>;
     #[inline(always)]
-    fn force(xi: &mut Vec2, inp: &TangentialInput) -> TangentialForce {
+    fn force<R: Real>(xi: &mut Vector2<R>, inp: &TangentialInput<R>) -> TangentialForce<R> {
         let n = inp.n;
         *xi += inp.vt * inp.dt;
         let along_n = xi.dot(&n);
-        *xi -= along_n * n;
-        let elastic = -inp.kt * *xi;
+        *xi -= n * along_n;
+        let elastic = *xi * -inp.kt;
         let f_el = elastic.norm();
-        // Branch-free: whether a contact slides is data, not control flow (about as often
-        // one way as the other in a sheared packing). cap >= 0, so sliding means f_el > 0.
-        let slide = f_el > inp.cap;
-        let scale = if slide { inp.cap / f_el } else { 1.0 };
+        // cap >= 0, so a sliding contact has f_el > 0.
+        let slide = f_el.simd_gt(inp.cap);
+        let scale = pick(slide, inp.cap / f_el, R::one());
         let scaled = elastic * scale;
-        let before = 0.5 * inp.kt * xi.norm_squared();
+        let before = k::<R>(0.5) * inp.kt * xi.norm_squared();
         let xi_slid = -scaled / inp.kt;
-        let after = 0.5 * inp.kt * xi_slid.norm_squared();
-        *xi = if slide { xi_slid } else { *xi };
-        let damping = -inp.gt * inp.vt;
-        TangentialForce { elastic: scaled, damping: if slide { Vec2::zeros() } else { damping }, slip_energy: if slide { before - after } else { 0.0 } }
+        let after = k::<R>(0.5) * inp.kt * xi_slid.norm_squared();
+        *xi = pick2(slide, xi_slid, *xi);
+        let damping = inp.vt * -inp.gt;
+        TangentialForce { elastic: scaled, damping: pick2(slide, Vector2::zeros(), damping), slip_energy: pick(slide, before - after, R::zero()) }
+    }
+    #[inline(always)]
+    fn gather(h: [&Vector2<f64>; crate::lanes::LANES]) -> Vector2<crate::lanes::Lanes> {
+        crate::lanes::gather2(|l| *h[l])
+    }
+    #[inline(always)]
+    fn lane(h: &Vector2<crate::lanes::Lanes>, l: usize) -> Vector2<f64> {
+        crate::lanes::lane2(h, l)
     }
 }
 
 /// State of a YADE-style incremental contact.
 #[derive(Clone, Copy, Debug, Default)]
-pub struct IncrementalState {
+pub struct IncrementalState<R: Real = f64> {
     /// Elastic tangential force on grain i, N.
-    pub force: Vec2,
+    pub force: Vector2<R>,
     /// The normal at the previous step (zero before the first step of a contact).
-    pub n_prev: Vec2,
+    pub n_prev: Vector2<R>,
 }
 
 /// YADE `Law2_ScGeom_MindlinPhys_Mindlin`: the elastic tangential force is rotated with
@@ -112,26 +132,33 @@ pub struct IncrementalForce;
 impl Tangential for IncrementalForce {
     const NAME: &'static str = "IncrementalForce";
     const FRICTION: bool = true;
-    type History = IncrementalState;
+    type History<R: Real> = IncrementalState<R>;
     #[inline(always)]
-    fn force(h: &mut IncrementalState, inp: &TangentialInput) -> TangentialForce {
+    fn force<R: Real>(h: &mut IncrementalState<R>, inp: &TangentialInput<R>) -> TangentialForce<R> {
         let n = inp.n;
         // Rotate with the normal: in the plane the axis n_prev x n is along z and the
         // first-order rotation adds (axis x F).
         let s = cross(h.n_prev, n);
         let f = h.force;
-        let rotated = f + s * Vec2::new(-f.y, f.x);
+        let rotated = f + Vector2::new(-f.y, f.x) * s;
         h.n_prev = n;
-        let trial = rotated - inp.kt * inp.vt * inp.dt;
+        let trial = rotated - inp.vt * inp.kt * inp.dt;
         let f_el = trial.norm();
-        if f_el > inp.cap {
-            let scaled = if f_el > 0.0 { trial * (inp.cap / f_el) } else { Vec2::zeros() };
-            let slip_energy = if inp.kt > 0.0 { 0.5 * (trial.norm_squared() - scaled.norm_squared()) / inp.kt } else { 0.0 };
-            h.force = scaled;
-            TangentialForce { elastic: scaled, damping: Vec2::zeros(), slip_energy }
-        } else {
-            h.force = trial;
-            TangentialForce { elastic: trial, damping: -inp.gt * inp.vt, slip_energy: 0.0 }
-        }
+        // cap >= 0, so a sliding contact has f_el > 0 (and kt > 0: the trial force grew).
+        let slide = f_el.simd_gt(inp.cap);
+        let scaled = trial * (inp.cap / f_el);
+        let slip_energy = k::<R>(0.5) * (trial.norm_squared() - scaled.norm_squared()) / inp.kt;
+        let elastic = pick2(slide, scaled, trial);
+        h.force = elastic;
+        let damping = inp.vt * -inp.gt;
+        TangentialForce { elastic, damping: pick2(slide, Vector2::zeros(), damping), slip_energy: pick(slide, slip_energy, R::zero()) }
+    }
+    #[inline(always)]
+    fn gather(h: [&IncrementalState<f64>; crate::lanes::LANES]) -> IncrementalState<crate::lanes::Lanes> {
+        IncrementalState { force: crate::lanes::gather2(|l| h[l].force), n_prev: crate::lanes::gather2(|l| h[l].n_prev) }
+    }
+    #[inline(always)]
+    fn lane(h: &IncrementalState<crate::lanes::Lanes>, l: usize) -> IncrementalState<f64> {
+        IncrementalState { force: crate::lanes::lane2(&h.force, l), n_prev: crate::lanes::lane2(&h.n_prev, l) }
     }
 }
