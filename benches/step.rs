@@ -62,6 +62,26 @@ fn contact_kernel(c: &mut Criterion) {
     let l = LiggghtsHertzHistory::new(options);
     let mut h = ContactHistory::default();
     c.bench_function("contact_kernel_liggghts_history", |b| b.iter(|| l.touch::<false>(black_box(&input), &pm, &mut h, &mut ledger)));
+    // Four such contacts at once in SIMD lanes (one iteration = four contacts).
+    {
+        use grainlab::lanes::{Lanes, gather, gather2};
+        use simba::simd::SimdValue;
+        let one = [input; 4];
+        let lanes = ContactInput {
+            n: gather2(|k| one[k].n),
+            dn: gather(|k| one[k].dn * (1.0 + 0.1 * k as f64)),
+            r_star: Lanes::splat(input.r_star),
+            m_star: Lanes::splat(input.m_star),
+            v_rel: gather2(|k| one[k].v_rel),
+            spin: Lanes::splat(input.spin),
+            dt: Lanes::splat(input.dt),
+            tangential_scale: Lanes::splat(1.0),
+        };
+        let pml = PairMaterial::gather([&pm; 4]);
+        let xi = grainlab::dim::Vec2::zeros();
+        let mut h = <grainlab::contact::tangential::TotalDisplacement as grainlab::contact::tangential::Tangential>::gather([&xi; 4]);
+        c.bench_function("contact_kernel_liggghts_history_four_lanes", |b| b.iter(|| l.force(black_box(&lanes), &pml, &mut h)));
+    }
     let y = YadeMindlin::new(options);
     let mut h = ContactHistory::default();
     c.bench_function("contact_kernel_yade_mindlin", |b| b.iter(|| y.touch::<false>(black_box(&input), &pm, &mut h, &mut ledger)));

@@ -391,9 +391,6 @@ impl Parts<'_> {
         if has_walls {
             stages.push(Box::new(MoveWalls));
         }
-        if world.boundary.is_periodic() {
-            stages.push(Box::new(PeriodicWrap));
-        }
         stages.extend(forces()?);
         if has_walls {
             stages.push(Box::new(FinishWalls::<E>));

@@ -5,7 +5,11 @@
 //! The forces are therefore evaluated with the half-step velocities v(n+1/2), as in
 //! LIGGGHTS and YADE: that is the velocity the damping and the tangential increment see.
 
+use std::sync::atomic::{AtomicBool, Ordering};
+
 use crate::contact::ContactLaw;
+use crate::dim::Vec2;
+use crate::neighbor::Neighbours;
 use crate::error::Error;
 use crate::particles::Particles;
 use crate::pipeline::Stage;
@@ -35,10 +39,14 @@ impl KickFactors {
     }
 }
 
-/// First half kick and drift of the free grains; `ROT` adds the spin half kick.
+/// First half kick and drift of the free grains; `ROT` adds the spin half kick. In the
+/// same pass over the grains: back into the periodic cell, and the neighbour list's
+/// watch (has a grain moved more than half the skin since the last build?).
 #[derive(Default)]
 pub struct InitialIntegrate<const ROT: bool> {
     k: KickFactors,
+    /// Stands in for the positions at the last build before there is a build.
+    origin: Vec<Vec2>,
 }
 
 impl<L: ContactLaw, const ROT: bool> Stage<L> for InitialIntegrate<ROT> {
@@ -50,20 +58,33 @@ impl<L: ContactLaw, const ROT: bool> Stage<L> for InitialIntegrate<ROT> {
         let p = &mut w.p;
         let n = p.n_free;
         self.k.update(p, dt);
-        w.threads.split(n, (&mut p.v[..n], &mut p.x[..n], &p.f[..n], &self.k.dtfm[..]), |(v, x, f, dtfm)| {
+        let (b, limit) = (w.boundary, w.neighbours.limit());
+        let listed = w.neighbours.at_build().len() == p.len();
+        if !listed {
+            // No list yet: the next stage builds one whatever this pass finds.
+            self.origin.resize(n, Vec2::zeros());
+        }
+        let at = if listed { &w.neighbours.at_build()[..n] } else { &self.origin[..] };
+        let far = AtomicBool::new(false);
+        let translation = (&mut p.v[..n], &mut p.x[..n], &p.f[..n], &self.k.dtfm[..], at);
+        let rotation = (&mut p.omega[..n], &mut p.theta[..n], &p.torque[..n], &self.k.dtfi[..]);
+        w.threads.split(n, (translation, rotation), |((v, x, f, dtfm, at), (omega, theta, torque, dtfi))| {
             for i in 0..v.len() {
                 v[i] += dtfm[i] * f[i];
                 x[i] += dt * v[i];
+                b.wrap(&mut x[i]);
             }
-        });
-        if ROT {
-            w.threads.split(n, (&mut p.omega[..n], &mut p.theta[..n], &p.torque[..n], &self.k.dtfi[..]), |(omega, theta, torque, dtfi)| {
+            if Neighbours::moved(x, at, &b, limit) {
+                far.store(true, Ordering::Relaxed);
+            }
+            if ROT {
                 for i in 0..omega.len() {
                     omega[i] += dtfi[i] * torque[i];
                     theta[i] += dt * omega[i];
                 }
-            });
-        }
+            }
+        });
+        w.neighbours.moved_far |= far.into_inner();
         Ok(())
     }
 }
@@ -82,18 +103,17 @@ impl<L: ContactLaw, const ROT: bool> Stage<L> for FinalIntegrate<ROT> {
         let p = &mut w.p;
         let n = p.n_free;
         self.k.update(p, w.dt);
-        w.threads.split(n, (&mut p.v[..n], &p.f[..n], &self.k.dtfm[..]), |(v, f, dtfm)| {
+        let rotation = (&mut p.omega[..n], &p.torque[..n], &self.k.dtfi[..]);
+        w.threads.split(n, ((&mut p.v[..n], &p.f[..n], &self.k.dtfm[..]), rotation), |((v, f, dtfm), (omega, torque, dtfi))| {
             for i in 0..v.len() {
                 v[i] += dtfm[i] * f[i];
             }
-        });
-        if ROT {
-            w.threads.split(n, (&mut p.omega[..n], &p.torque[..n], &self.k.dtfi[..]), |(omega, torque, dtfi)| {
+            if ROT {
                 for i in 0..omega.len() {
                     omega[i] += dtfi[i] * torque[i];
                 }
-            });
-        }
+            }
+        });
         Ok(())
     }
 }

@@ -10,6 +10,7 @@
 use crate::boundary::Boundary;
 use crate::contact::ContactHistory;
 use crate::dim::Vec2;
+use crate::threads::Threads;
 
 /// The Verlet list and the history of each listed pair.
 #[derive(Clone, Debug, Default)]
@@ -72,36 +73,48 @@ pub struct Neighbours {
     pub builds: u64,
     cell_start: Vec<u32>,
     cell_items: Vec<u32>,
+    /// Set by the stages that move grains (the drift, the walls) when one of them has
+    /// moved more than half the skin since the last build; cleared by the build.
+    pub moved_far: bool,
 }
 
 impl Neighbours {
     pub fn new(skin: f64) -> Self {
-        Neighbours { skin, x_at_build: Vec::new(), builds: 0, cell_start: Vec::new(), cell_items: Vec::new() }
+        Neighbours { skin, x_at_build: Vec::new(), builds: 0, cell_start: Vec::new(), cell_items: Vec::new(), moved_far: false }
     }
 
-    /// True when some grain has moved more than half the skin since the last build.
-    /// A full sweep without an early exit, so that it vectorises.
-    pub fn needs_rebuild(&self, x: &[Vec2], boundary: &Boundary, threads: &crate::threads::Threads) -> bool {
-        if self.x_at_build.len() != x.len() {
-            return true;
-        }
-        let limit = 0.25 * self.skin * self.skin;
-        let moved = std::sync::atomic::AtomicBool::new(false);
-        threads.split(x.len(), (x, &self.x_at_build[..]), |(x, at_build)| {
-            let far = x.iter().zip(at_build).fold(false, |far, (a, b)| far | (boundary.image(a - b).norm_squared() > limit));
-            if far {
-                moved.store(true, std::sync::atomic::Ordering::Relaxed);
-            }
-        });
-        moved.into_inner()
+    /// Half the skin, squared: a grain that has moved this far (squared) since the last
+    /// build may have a new neighbour, m^2.
+    pub fn limit(&self) -> f64 {
+        0.25 * self.skin * self.skin
+    }
+
+    /// Positions at the last build (empty before the first).
+    pub fn at_build(&self) -> &[Vec2] {
+        &self.x_at_build
+    }
+
+    /// True when one of the grains at `x` has moved more than half the skin from `at`
+    /// (its position at the last build). A full sweep without an early exit, so that it
+    /// vectorises; the stages that move grains call it on what they moved.
+    #[inline(always)]
+    pub fn moved(x: &[Vec2], at: &[Vec2], boundary: &Boundary, limit: f64) -> bool {
+        x.iter().zip(at).fold(false, |far, (a, b)| far | (boundary.image(a - b).norm_squared() > limit))
+    }
+
+    /// True when the list must be rebuilt: there is none for these `n` grains yet, or a
+    /// grain has moved more than half the skin ([`Neighbours::moved_far`]).
+    pub fn needs_rebuild(&self, n: usize) -> bool {
+        self.x_at_build.len() != n || self.moved_far
     }
 
     /// Build the pair list with the cell list.
-    pub fn build(&mut self, x: &[Vec2], r: &[f64], n_free: usize, boundary: &Boundary) -> Vec<[u32; 2]> {
+    pub fn build(&mut self, x: &[Vec2], r: &[f64], n_free: usize, boundary: &Boundary, threads: &Threads) -> Vec<[u32; 2]> {
         self.builds += 1;
+        self.moved_far = false;
         self.x_at_build.clear();
         self.x_at_build.extend_from_slice(x);
-        cell_pairs(x, r, n_free, boundary, self.skin, &mut self.cell_start, &mut self.cell_items)
+        cell_pairs_on(x, r, n_free, boundary, self.skin, &mut self.cell_start, &mut self.cell_items, threads)
     }
 }
 
@@ -136,6 +149,22 @@ pub fn cell_pairs(
     skin: f64,
     cell_start: &mut Vec<u32>,
     cell_items: &mut Vec<u32>,
+) -> Vec<[u32; 2]> {
+    cell_pairs_on(x, r, n_free, boundary, skin, cell_start, cell_items, &Threads::serial())
+}
+
+/// [`cell_pairs`] on `threads`: each thread lists the pairs (i, j > i) of its own grains
+/// i, already in order, so the parts join into the sorted list with no sort.
+#[allow(clippy::too_many_arguments)]
+pub fn cell_pairs_on(
+    x: &[Vec2],
+    r: &[f64],
+    n_free: usize,
+    boundary: &Boundary,
+    skin: f64,
+    cell_start: &mut Vec<u32>,
+    cell_items: &mut Vec<u32>,
+    threads: &Threads,
 ) -> Vec<[u32; 2]> {
     let n = x.len();
     if n < 2 {
@@ -193,51 +222,58 @@ pub fn cell_pairs(
         cell_items[fill[c as usize] as usize] = i as u32;
         fill[c as usize] += 1;
     }
-    // Half stencil: the cell itself, then right, upper-left, up, upper-right.
-    let stencil: &[(isize, isize)] = if nx == 1 { &[(0, 1)] } else { &[(1, 0), (-1, 1), (0, 1), (1, 1)] };
-    let mut out = Vec::new();
-    let push = |i: u32, j: u32, out: &mut Vec<[u32; 2]>| {
-        let (a, b) = if i < j { (i, j) } else { (j, i) };
-        if (a as usize) >= n_free && (b as usize) >= n_free {
-            return;
-        }
-        if listed(boundary.image(x[a as usize] - x[b as usize]), r[a as usize], r[b as usize], skin) {
-            out.push([a, b]);
-        }
-    };
-    for cy in 0..ny {
-        for cx in 0..nx {
-            let c = cy * nx + cx;
-            let own = &cell_items[cell_start[c] as usize..cell_start[c + 1] as usize];
-            for (k, &i) in own.iter().enumerate() {
-                for &j in &own[k + 1..] {
-                    push(i, j, &mut out);
-                }
+    let (cell_start, cell_items) = (&cell_start[..], &cell_items[..]);
+    // Each grain with the grains of higher index in its cell and the eight around it.
+    let pairs_of = |i: usize, out: &mut Vec<[u32; 2]>| {
+        let c = cells[i] as usize;
+        let (cx, cy) = ((c % nx) as isize, (c / nx) as isize);
+        let mut around = [0usize; 9];
+        let mut m = 0;
+        for oy in -1..=1 {
+            let y = cy + oy;
+            if y < 0 || y >= ny as isize {
+                continue;
             }
-            for &(ox, oy) in stencil {
-                let ny2 = cy as isize + oy;
-                if ny2 < 0 || ny2 >= ny as isize {
-                    continue;
-                }
-                let mut nx2 = cx as isize + ox;
-                if nx2 < 0 || nx2 >= nx as isize {
+            for ox in -1..=1 {
+                let mut xx = cx + ox;
+                if xx < 0 || xx >= nx as isize {
                     if !periodic {
                         continue;
                     }
-                    nx2 = nx2.rem_euclid(nx as isize);
+                    xx = xx.rem_euclid(nx as isize);
                 }
-                let d = ny2 as usize * nx + nx2 as usize;
-                let other = &cell_items[cell_start[d] as usize..cell_start[d + 1] as usize];
-                for &i in own {
-                    for &j in other {
-                        push(i, j, &mut out);
-                    }
+                around[m] = y as usize * nx + xx as usize;
+                m += 1;
+            }
+        }
+        let around = &mut around[..m];
+        around.sort_unstable();
+        let start = out.len();
+        for (k, &d) in around.iter().enumerate() {
+            if k > 0 && around[k - 1] == d {
+                continue;
+            }
+            for &j in &cell_items[cell_start[d] as usize..cell_start[d + 1] as usize] {
+                let j = j as usize;
+                if j > i && (i < n_free || j < n_free) && listed(boundary.image(x[i] - x[j]), r[i], r[j], skin) {
+                    out.push([i as u32, j as u32]);
                 }
             }
         }
+        out[start..].sort_unstable();
+    };
+    let bounds = threads.bounds(n);
+    let mut parts: Vec<Vec<[u32; 2]>> = (0..threads.count()).map(|_| Vec::new()).collect();
+    threads.each(parts.iter_mut().collect(), |t, out: &mut Vec<[u32; 2]>| {
+        out.reserve(3 * (bounds[t + 1] - bounds[t]));
+        for i in bounds[t]..bounds[t + 1] {
+            pairs_of(i, out);
+        }
+    });
+    if parts.len() == 1 {
+        return parts.pop().unwrap_or_default();
     }
-    out.sort_unstable();
-    out
+    parts.concat()
 }
 
 #[cfg(test)]

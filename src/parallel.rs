@@ -95,10 +95,18 @@ impl<const ENERGY: bool> ParallelPairForces<ENERGY> {
         for g in 0..n {
             first[g + 1] += first[g];
         }
-        // The threads' grain ranges of the per-grain stages, so that each thread works
-        // on the same grains (in its cache) in every stage.
+        // Ranges with about the same number of pairs each (the grains of rough walls,
+        // last in the index space, own no pairs). They stay close to the equal ranges
+        // of the per-grain stages, so that each thread mostly works on the same grains.
         let t = self.scratch.len();
-        self.bounds = self.threads.bounds(n);
+        self.bounds.clear();
+        self.bounds.push(0);
+        for r in 1..t {
+            let target = pairs.len() * r / t;
+            let g = first.partition_point(|&c| c < target).min(n);
+            self.bounds.push(g.max(*self.bounds.last().unwrap()));
+        }
+        self.bounds.push(n);
         self.pair_bounds = self.bounds.iter().map(|&g| first[g]).collect();
         let range_of = |g: usize, b: &[usize]| b.partition_point(|&x| x <= g) - 1;
         self.cross.clear();
@@ -176,11 +184,11 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
                         }
                     }
                 }
-                sort_pairs(view.p, &view.boundary, &pairs[part.clone()], hist, Some(&cross_slot[part.clone()]), &mut sc.touching, &mut sc.released);
+                let (nt, nr) = sort_pairs(view.p, &view.boundary, &pairs[part.clone()], hist, Some(&cross_slot[part.clone()]), &mut sc.touching, &mut sc.released);
                 let mut none = EnergyLedger::default();
                 let l = if ENERGY { Ledgers::PerPair(ledgers) } else { Ledgers::One(&mut none) };
                 let list = PairSlices::<T> { pairs: &pairs[part.clone()], consts: &consts[part.clone()], hist };
-                compute_pairs::<Dm, T, ENERGY>(&view, list, &sc.touching, &sc.released, l, &mut sc.out);
+                compute_pairs::<Dm, T, ENERGY>(&view, list, &sc.touching[..nt], &sc.released[..nr], l, &mut sc.out);
                 let mut best = (0.0, usize::MAX);
                 let mut add = |k: usize, o: &PairOut, own: bool| {
                     let (i, j) = (pairs[k][0] as usize - g0, pairs[k][1] as usize);
@@ -199,7 +207,7 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
                     }
                 };
                 let mut c = cb[r];
-                for (&kk, o) in sc.touching.iter().zip(&sc.out) {
+                for (&kk, o) in sc.touching[..nt].iter().zip(&sc.out) {
                     let k = part.start + kk as usize;
                     while c < cb[r + 1] && (cross[c] as usize) < k {
                         let oc = &cross_out[c];

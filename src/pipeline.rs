@@ -13,7 +13,7 @@ use crate::contact::{ContactHistory, ContactInput, ContactLaw, ContactModel, Lev
 use crate::dim::{Vec2, cross};
 use crate::lanes::{LANES, Lanes, Real, gather, gather2, lane2};
 use crate::material::PairMaterial;
-use crate::neighbor::PairConst;
+use crate::neighbor::{Neighbours, PairConst};
 use crate::observe::energy::EnergyLedger;
 use crate::particles::Particles;
 use crate::error::Error;
@@ -27,7 +27,8 @@ pub trait Stage<L: ContactLaw>: Send {
 }
 
 /// Move the walls: prescribed x velocity, and for a loaded wall the first half kick and
-/// drift in y; glued grains follow their wall.
+/// drift in y; glued grains follow their wall (wrapped into the periodic cell, and
+/// watched for the neighbour list's skin).
 pub struct MoveWalls;
 
 impl<L: ContactLaw> Stage<L> for MoveWalls {
@@ -46,24 +47,16 @@ impl<L: ContactLaw> Stage<L> for MoveWalls {
             if let Surface::Rough { grains } = &wall.surface {
                 for k in grains.clone() {
                     w.p.x[k] += d;
+                    w.boundary.wrap(&mut w.p.x[k]);
                     w.p.v[k] = wall.v;
+                }
+                let at = w.neighbours.at_build();
+                if at.len() == w.p.len() {
+                    let far = Neighbours::moved(&w.p.x[grains.clone()], &at[grains.clone()], &w.boundary, w.neighbours.limit());
+                    w.neighbours.moved_far |= far;
                 }
             }
         }
-        Ok(())
-    }
-}
-
-/// Bring grains that left the periodic cell back in.
-pub struct PeriodicWrap;
-
-impl<L: ContactLaw> Stage<L> for PeriodicWrap {
-    fn name(&self) -> String {
-        "PeriodicX".into()
-    }
-    fn run(&mut self, w: &mut World<L>) -> Result<(), Error> {
-        let b = w.boundary;
-        w.threads.split(w.p.x.len(), &mut w.p.x[..], |x| x.iter_mut().for_each(|x| b.wrap(x)));
         Ok(())
     }
 }
@@ -76,8 +69,8 @@ impl<L: ContactLaw> Stage<L> for UpdateNeighbours {
         "Neighbours".into()
     }
     fn run(&mut self, w: &mut World<L>) -> Result<(), Error> {
-        if w.neighbours.needs_rebuild(&w.p.x, &w.boundary, &w.threads) {
-            let pairs = w.neighbours.build(&w.p.x, &w.p.r, w.p.n_free, &w.boundary);
+        if w.neighbours.needs_rebuild(w.p.len()) {
+            let pairs = w.neighbours.build(&w.p.x, &w.p.r, w.p.n_free, &w.boundary, &w.threads);
             w.pairs.replace(pairs, &w.p.r, &w.p.m);
         }
         Ok(())
@@ -295,14 +288,16 @@ impl Ledgers<'_> {
     }
 }
 
-/// The pairs of a list part that are touching (`touching`), and those that were at the
-/// previous step and are not any more (`released`), as indices into the part, in list
-/// order; `skip` (if given) leaves out pairs computed elsewhere. No branch per pair.
-pub fn sort_pairs<H>(p: &Particles, boundary: &Boundary, pairs: &[[u32; 2]], hist: &[ContactHistory<H>], skip: Option<&[u32]>, touching: &mut Vec<u32>, released: &mut Vec<u32>) {
-    touching.clear();
-    released.clear();
-    touching.resize(pairs.len(), 0);
-    released.resize(pairs.len(), 0);
+/// The pairs of a list part that are touching, and those that were at the previous step
+/// and are not any more, as indices into the part, in list order: the first `nt` of
+/// `touching` and the first `nr` of `released`, `(nt, nr)` returned. `skip` (if given)
+/// leaves out pairs computed elsewhere. No branch per pair, and the lists keep their
+/// length from step to step (no clearing).
+pub fn sort_pairs<H>(p: &Particles, boundary: &Boundary, pairs: &[[u32; 2]], hist: &[ContactHistory<H>], skip: Option<&[u32]>, touching: &mut Vec<u32>, released: &mut Vec<u32>) -> (usize, usize) {
+    if touching.len() < pairs.len() {
+        touching.resize(pairs.len(), 0);
+        released.resize(pairs.len(), 0);
+    }
     let (mut nt, mut nr) = (0, 0);
     for (k, (pair, h)) in pairs.iter().zip(hist).enumerate() {
         let (i, j) = (pair[0] as usize, pair[1] as usize);
@@ -315,15 +310,14 @@ pub fn sort_pairs<H>(p: &Particles, boundary: &Boundary, pairs: &[[u32; 2]], his
         nt += (touch & mine) as usize;
         nr += (!touch & h.active & mine) as usize;
     }
-    touching.truncate(nt);
-    released.truncate(nr);
+    (nt, nr)
 }
 
 /// Compute the pairs `touching` and `released` of a list part (indices from
-/// [`sort_pairs`]): their outputs, in list order, go to `out` (`out[m]` for
-/// `order[m]`); `order` lists both kinds merged in list order. Without the energy
-/// ledger the touching pairs run four at a time in SIMD lanes; with it, one by one in
-/// list order, so that the ledger sums in the serial order.
+/// [`sort_pairs`]): the output of `touching[m]` goes to `out[m]` (`out` keeps its
+/// length from step to step; it grows when needed). Without the energy ledger the
+/// touching pairs run four at a time in SIMD lanes; with it, one by one with the
+/// released ones in list order, so that the ledger sums in the serial order.
 pub fn compute_pairs<Dm: Damping, T: Tangential, const ENERGY: bool>(
     w: &PairView<'_, ContactModel<Dm, T>>,
     list: PairSlices<'_, T>,
@@ -333,7 +327,9 @@ pub fn compute_pairs<Dm: Damping, T: Tangential, const ENERGY: bool>(
     out: &mut Vec<PairOut>,
 ) {
     let PairSlices { pairs, consts, hist } = list;
-    out.clear();
+    if out.len() < touching.len() {
+        out.resize(touching.len(), PairOut::default());
+    }
     if ENERGY {
         // Both kinds merged in list order: the ledger is a sum.
         let (mut a, mut b) = (0, 0);
@@ -342,7 +338,7 @@ pub fn compute_pairs<Dm: Damping, T: Tangential, const ENERGY: bool>(
             let k = if touch { touching[a] } else { released[b] } as usize;
             let o = pair_contact::<Dm, T, ENERGY>(w, pairs[k], &consts[k], &mut hist[k], ledgers.get(k));
             if touch {
-                out.push(o);
+                out[a] = o;
                 a += 1;
             } else {
                 b += 1;
@@ -350,7 +346,6 @@ pub fn compute_pairs<Dm: Damping, T: Tangential, const ENERGY: bool>(
         }
         return;
     }
-    out.resize(touching.len(), PairOut::default());
     let quads = touching.len() / LANES * LANES;
     for (ks, o) in touching[..quads].chunks_exact(LANES).zip(out.chunks_exact_mut(LANES)) {
         four_pairs(w, PairSlices::<T> { pairs, consts, hist: &mut *hist }, ks, o);
@@ -395,11 +390,12 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
         let mut f = std::mem::take(&mut w.p.f);
         let mut torque = std::mem::take(&mut w.p.torque);
         let (pairs, consts) = (&w.pairs.pairs, &w.pairs.consts);
-        sort_pairs(&w.p, &w.boundary, pairs, &w.pairs.hist, None, &mut self.touching, &mut self.released);
+        let (nt, nr) = sort_pairs(&w.p, &w.boundary, pairs, &w.pairs.hist, None, &mut self.touching, &mut self.released);
+        let (touching, released) = (&self.touching[..nt], &self.released[..nr]);
         let view = PairView { p: &w.p, boundary: w.boundary, law: w.law, pair_table: &w.pair_table, dt: w.dt };
         let list = PairSlices::<T> { pairs, consts, hist: &mut w.pairs.hist };
-        compute_pairs::<Dm, T, ENERGY>(&view, list, &self.touching, &self.released, Ledgers::One(&mut w.ledger), &mut self.out);
-        for (&k, o) in self.touching.iter().zip(&self.out) {
+        compute_pairs::<Dm, T, ENERGY>(&view, list, touching, released, Ledgers::One(&mut w.ledger), &mut self.out);
+        for (&k, o) in touching.iter().zip(&self.out) {
             let pair = pairs[k as usize];
             let (i, j) = (pair[0] as usize, pair[1] as usize);
             f[i] += o.force;
