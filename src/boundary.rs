@@ -33,8 +33,10 @@ impl Boundary {
     /// Bring a position back into [x_min, x_min + period).
     #[inline(always)]
     pub fn wrap(&self, x: &mut Vec2) {
-        if self.period > 0.0 {
-            let v = (x.x - self.x_min) * self.inv_period;
+        let xr = x.x - self.x_min;
+        // Inside already (almost always: a predictable branch, no rounding).
+        if self.period > 0.0 && !(xr >= 0.0 && xr < self.period) {
+            let v = xr * self.inv_period;
             let s = nearest_integer(v);
             let s = if s > v { s - 1.0 } else { s };
             x.x -= s * self.period;

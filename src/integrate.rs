@@ -69,18 +69,18 @@ impl<L: ContactLaw, const ROT: bool> Stage<L> for InitialIntegrate<ROT> {
         let translation = (&mut p.v[..n], &mut p.x[..n], &p.f[..n], &self.k.dtfm[..], at);
         let rotation = (&mut p.omega[..n], &mut p.theta[..n], &p.torque[..n], &self.k.dtfi[..]);
         w.threads.split(n, (translation, rotation), |((v, x, f, dtfm, at), (omega, theta, torque, dtfi))| {
-            for i in 0..v.len() {
-                v[i] += dtfm[i] * f[i];
-                x[i] += dt * v[i];
-                b.wrap(&mut x[i]);
+            for (((v, x), f), m) in v.iter_mut().zip(x.iter_mut()).zip(f).zip(dtfm) {
+                *v += *m * *f;
+                *x += dt * *v;
+                b.wrap(x);
             }
             if Neighbours::moved(x, at, &b, limit) {
                 far.store(true, Ordering::Relaxed);
             }
             if ROT {
-                for i in 0..omega.len() {
-                    omega[i] += dtfi[i] * torque[i];
-                    theta[i] += dt * omega[i];
+                for (((w, th), t), m) in omega.iter_mut().zip(theta.iter_mut()).zip(torque).zip(dtfi) {
+                    *w += *m * *t;
+                    *th += dt * *w;
                 }
             }
         });
@@ -105,12 +105,12 @@ impl<L: ContactLaw, const ROT: bool> Stage<L> for FinalIntegrate<ROT> {
         self.k.update(p, w.dt);
         let rotation = (&mut p.omega[..n], &p.torque[..n], &self.k.dtfi[..]);
         w.threads.split(n, ((&mut p.v[..n], &p.f[..n], &self.k.dtfm[..]), rotation), |((v, f, dtfm), (omega, torque, dtfi))| {
-            for i in 0..v.len() {
-                v[i] += dtfm[i] * f[i];
+            for ((v, f), m) in v.iter_mut().zip(f).zip(dtfm) {
+                *v += *m * *f;
             }
             if ROT {
-                for i in 0..omega.len() {
-                    omega[i] += dtfi[i] * torque[i];
+                for ((w, t), m) in omega.iter_mut().zip(torque).zip(dtfi) {
+                    *w += *m * *t;
                 }
             }
         });

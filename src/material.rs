@@ -152,6 +152,10 @@ impl PairTable {
         }
         PairTable { n, pairs }
     }
+    /// The one pair of a scene with one material.
+    pub fn single(&self) -> Option<&PairMaterial> {
+        if self.n == 1 { self.pairs.first() } else { None }
+    }
     #[inline(always)]
     pub fn get(&self, i: usize, j: usize) -> &PairMaterial {
         &self.pairs[i * self.n + j]

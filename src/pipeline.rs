@@ -238,7 +238,7 @@ pub fn pair_contact<Dm: Damping, T: Tangential, const ENERGY: bool>(
 /// Four touching pairs at once, one per SIMD lane (`ks`: their indices in the list);
 /// the same bits as [`pair_contact`] gives each of them, without the energy ledger.
 #[inline(always)]
-fn four_pairs<Dm: Damping, T: Tangential>(w: &PairView<'_, ContactModel<Dm, T>>, list: PairSlices<'_, T>, ks: &[u32], out: &mut [PairOut]) {
+fn four_pairs<Dm: Damping, T: Tangential>(w: &PairView<'_, ContactModel<Dm, T>>, list: PairSlices<'_, T>, single: Option<&PairMaterial<Lanes>>, ks: &[u32], out: &mut [PairOut]) {
     let (model, p) = (w.law, w.p);
     let lever = model.options.lever_arm;
     let ij: [(usize, usize); LANES] = std::array::from_fn(|l| {
@@ -251,7 +251,10 @@ fn four_pairs<Dm: Damping, T: Tangential>(w: &PairView<'_, ContactModel<Dm, T>>,
     let (wi, wj) = if T::FRICTION { (gather(|l| p.omega[ij[l].0]), gather(|l| p.omega[ij[l].1])) } else { (Lanes::splat(0.0), Lanes::splat(0.0)) };
     let v_rel = gather2(|l| p.v[ij[l].0] - p.v[ij[l].1]);
     let input = pair_input::<Lanes, T>(lever, d, ri, rj, wi, wj, v_rel, gather(|l| pc[l].r_star), gather(|l| pc[l].m_star), Lanes::splat(w.dt));
-    let pm = PairMaterial::gather(std::array::from_fn(|l| w.pair_table.get(p.material[ij[l].0] as usize, p.material[ij[l].1] as usize)));
+    let pm = match single {
+        Some(pm) => *pm,
+        None => PairMaterial::gather(std::array::from_fn(|l| w.pair_table.get(p.material[ij[l].0] as usize, p.material[ij[l].1] as usize))),
+    };
     let mut h = T::gather(std::array::from_fn(|l| &list.hist[ks[l] as usize].tangential));
     let c = model.force(&input, &pm, &mut h);
     let torque = if T::FRICTION { pair_torque(lever, &input, c.tangential.elastic + c.tangential.damping, ri, rj) } else { [Lanes::splat(0.0); 2] };
@@ -347,8 +350,10 @@ pub fn compute_pairs<Dm: Damping, T: Tangential, const ENERGY: bool>(
         return;
     }
     let quads = touching.len() / LANES * LANES;
+    // One material: its lanes once, not a table lookup per lane.
+    let single = w.pair_table.single().map(|m| PairMaterial::gather([m; LANES]));
     for (ks, o) in touching[..quads].chunks_exact(LANES).zip(out.chunks_exact_mut(LANES)) {
-        four_pairs(w, PairSlices::<T> { pairs, consts, hist: &mut *hist }, ks, o);
+        four_pairs(w, PairSlices::<T> { pairs, consts, hist: &mut *hist }, single.as_ref(), ks, o);
     }
     let mut none = EnergyLedger::default();
     for (m, &k) in touching.iter().enumerate().skip(quads) {
