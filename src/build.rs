@@ -70,7 +70,7 @@ impl<L: ContactLaw> Engine for Simulation<L> {
         self.world.dt
     }
     fn touching(&self) -> usize {
-        self.world.pairs.touching() + self.world.wall_hist.iter().flatten().filter(|h| h.active).count()
+        self.world.pairs.touching() + self.world.wall_active.iter().flatten().filter(|&&a| a).count()
     }
     fn neighbour_builds(&self) -> u64 {
         self.world.neighbours.builds
@@ -347,6 +347,7 @@ impl Parts<'_> {
         let gravity = Vec2::from(scene.gravity);
         let n_free = self.p.n_free;
         let wall_hist = self.walls.iter().map(|w| if w.is_flat() { vec![ContactHistory::default(); n_free] } else { Vec::new() }).collect();
+        let wall_active = self.walls.iter().map(|w| vec![false; if w.is_flat() { n_free } else { 0 }]).collect();
         let world = World {
             p: self.p,
             boundary: self.boundary,
@@ -356,6 +357,7 @@ impl Parts<'_> {
             pairs: PairList::default(),
             walls: self.walls,
             wall_hist,
+            wall_active,
             neighbours: Neighbours::new(self.skin),
             ledger: EnergyLedger::default(),
             gravity,

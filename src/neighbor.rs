@@ -21,6 +21,8 @@ pub struct PairList<H> {
     pub consts: Vec<PairConst>,
     /// History of each pair, parallel to `pairs`.
     pub hist: Vec<ContactHistory<H>>,
+    /// True while the pair is (or was at the previous step) touching, parallel to `pairs`.
+    pub active: Vec<bool>,
 }
 
 /// The constants of a listed pair, computed once per neighbour-list build.
@@ -44,21 +46,24 @@ impl<H: Copy + Default> PairList<H> {
             PairConst { r_star: crate::material::reduced(r[i], r[j]), m_star: crate::material::reduced(m[i], m[j]), inv_r_min: 1.0 / r[i].min(r[j]) }
         }));
         let mut hist = vec![ContactHistory::default(); new_pairs.len()];
+        let mut active = vec![false; new_pairs.len()];
         let mut k = 0;
-        for (slot, p) in hist.iter_mut().zip(&new_pairs) {
+        for ((slot, on), p) in hist.iter_mut().zip(active.iter_mut()).zip(&new_pairs) {
             while k < self.pairs.len() && self.pairs[k] < *p {
                 k += 1;
             }
             if k < self.pairs.len() && self.pairs[k] == *p {
                 *slot = self.hist[k];
+                *on = self.active[k];
             }
         }
         self.pairs = new_pairs;
         self.hist = hist;
+        self.active = active;
     }
     /// Number of pairs currently touching (active history).
     pub fn touching(&self) -> usize {
-        self.hist.iter().filter(|h| h.active).count()
+        self.active.iter().filter(|&&a| a).count()
     }
 }
 
@@ -287,7 +292,7 @@ mod tests {
         list.replace(vec![[0, 1], [0, 2], [3, 4]], &r, &m);
         for (k, h) in list.hist.iter_mut().enumerate() {
             h.tangential = k as f64 + 1.0;
-            h.active = true;
+            list.active[k] = true;
         }
         // [0, 2] leaves, [1, 2] and [2, 3] arrive, the others stay.
         list.replace(vec![[0, 1], [1, 2], [2, 3], [3, 4]], &r, &m);

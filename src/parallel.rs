@@ -155,24 +155,25 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
         let threads = &self.threads;
         {
             // (1) Each range's cross pairs, into their slots.
-            let parts = cut(&mut w.pairs.hist, pb).into_iter().zip(cut(&mut self.ledgers, &ledger_bounds)).zip(cut(&mut self.cross_out, cb));
-            threads.each(parts.collect(), |r, ((hist, ledgers), out)| {
+            let parts = cut(&mut w.pairs.hist, pb).into_iter().zip(cut(&mut w.pairs.active, pb)).zip(cut(&mut self.ledgers, &ledger_bounds)).zip(cut(&mut self.cross_out, cb));
+            threads.each(parts.collect(), |r, (((hist, active), ledgers), out)| {
                 let mut none = EnergyLedger::default();
                 for (s, o) in (cb[r]..cb[r + 1]).zip(out.iter_mut()) {
                     let k = cross[s] as usize;
                     let l = if ENERGY { &mut ledgers[k - pb[r]] } else { &mut none };
-                    *o = pair_contact::<Dm, T, ENERGY>(&view, pairs[k], &consts[k], &mut hist[k - pb[r]], l);
+                    *o = pair_contact::<Dm, T, ENERGY>(&view, pairs[k], &consts[k], &mut hist[k - pb[r]], &mut active[k - pb[r]], l);
                 }
             });
             let cross_out = &self.cross_out;
             // (2) Each range: incoming cross pairs, then its own part of the list.
             let parts = cut(&mut w.pairs.hist, pb)
                 .into_iter()
+                .zip(cut(&mut w.pairs.active, pb))
                 .zip(cut(&mut self.ledgers, &ledger_bounds))
                 .zip(cut(&mut f, bounds))
                 .zip(cut(&mut torque, bounds))
                 .zip(self.scratch.iter_mut());
-            threads.each(parts.collect(), |r, ((((hist, ledgers), fl), tl), sc)| {
+            threads.each(parts.collect(), |r, (((((hist, active), ledgers), fl), tl), sc)| {
                 let (g0, part) = (bounds[r], pb[r]..pb[r + 1]);
                 for &s in &incoming[r] {
                     let o = &cross_out[s as usize];
@@ -184,10 +185,10 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
                         }
                     }
                 }
-                let (nt, nr) = sort_pairs(view.p, &view.boundary, &pairs[part.clone()], hist, Some(&cross_slot[part.clone()]), &mut sc.touching, &mut sc.released);
+                let (nt, nr) = sort_pairs(view.p, &view.boundary, &pairs[part.clone()], active, Some(&cross_slot[part.clone()]), &mut sc.touching, &mut sc.released);
                 let mut none = EnergyLedger::default();
                 let l = if ENERGY { Ledgers::PerPair(ledgers) } else { Ledgers::One(&mut none) };
-                let list = PairSlices::<T> { pairs: &pairs[part.clone()], consts: &consts[part.clone()], hist };
+                let list = PairSlices::<T> { pairs: &pairs[part.clone()], consts: &consts[part.clone()], hist, active };
                 compute_pairs::<Dm, T, ENERGY>(&view, list, &sc.touching[..nt], &sc.released[..nr], l, &mut sc.out);
                 let mut best = (0.0, usize::MAX);
                 let mut add = |k: usize, o: &PairOut, own: bool| {

@@ -209,6 +209,7 @@ pub fn pair_contact<Dm: Damping, T: Tangential, const ENERGY: bool>(
     pair: [u32; 2],
     pc: &PairConst,
     h: &mut crate::sim::Hist<ContactModel<Dm, T>>,
+    active: &mut bool,
     ledger: &mut EnergyLedger,
 ) -> PairOut {
     let model = w.law;
@@ -220,17 +221,19 @@ pub fn pair_contact<Dm: Damping, T: Tangential, const ENERGY: bool>(
     let (ri, rj) = (p.r[i], p.r[j]);
     let radsum = ri + rj;
     if rsq >= radsum * radsum {
-        if h.active {
+        if *active {
             let n = d / rsq.sqrt();
             let spin = if T::FRICTION { ri * p.omega[i] + rj * p.omega[j] } else { 0.0 };
             let vc = p.v[i] - p.v[j] + spin * Vec2::new(n.y, -n.x);
             model.release::<ENERGY>(vc, n, w.dt, h, ledger);
+            *active = false;
         }
         return PairOut::default();
     }
     let input = pair_input::<f64, T>(lever, d, ri, rj, p.omega[i], p.omega[j], p.v[i] - p.v[j], pc.r_star, pc.m_star, w.dt);
     let pm = w.pair_table.get(p.material[i] as usize, p.material[j] as usize);
     let c = model.touch::<ENERGY>(&input, pm, h, ledger);
+    *active = true;
     let torque = if T::FRICTION { pair_torque(lever, &input, c.tangential, ri, rj) } else { [0.0, 0.0] };
     PairOut { force: c.force, torque, ratio: input.dn * pc.inv_r_min }
 }
@@ -260,18 +263,18 @@ fn four_pairs<Dm: Damping, T: Tangential>(w: &PairView<'_, ContactModel<Dm, T>>,
     let torque = if T::FRICTION { pair_torque(lever, &input, c.tangential.elastic + c.tangential.damping, ri, rj) } else { [Lanes::splat(0.0); 2] };
     let ratio = input.dn * gather(|l| pc[l].inv_r_min);
     for l in 0..LANES {
-        let hk = &mut list.hist[ks[l] as usize];
-        hk.tangential = T::lane(&h, l);
-        hk.active = true;
+        list.hist[ks[l] as usize].tangential = T::lane(&h, l);
+        list.active[ks[l] as usize] = true;
         out[l] = PairOut { force: lane2(&c.force, l), torque: [torque[0].extract(l), torque[1].extract(l)], ratio: ratio.extract(l) };
     }
 }
 
-/// A part of the pair list: the pairs, their constants and histories.
+/// A part of the pair list: the pairs, their constants, histories and touching flags.
 pub struct PairSlices<'a, T: Tangential> {
     pub pairs: &'a [[u32; 2]],
     pub consts: &'a [PairConst],
     pub hist: &'a mut [ContactHistory<T::History<f64>>],
+    pub active: &'a mut [bool],
 }
 
 /// Where the energy terms of the pairs go: the world's ledger (serial order), or one
@@ -296,13 +299,13 @@ impl Ledgers<'_> {
 /// `touching` and the first `nr` of `released`, `(nt, nr)` returned. `skip` (if given)
 /// leaves out pairs computed elsewhere. No branch per pair, and the lists keep their
 /// length from step to step (no clearing).
-pub fn sort_pairs<H>(p: &Particles, boundary: &Boundary, pairs: &[[u32; 2]], hist: &[ContactHistory<H>], skip: Option<&[u32]>, touching: &mut Vec<u32>, released: &mut Vec<u32>) -> (usize, usize) {
+pub fn sort_pairs(p: &Particles, boundary: &Boundary, pairs: &[[u32; 2]], active: &[bool], skip: Option<&[u32]>, touching: &mut Vec<u32>, released: &mut Vec<u32>) -> (usize, usize) {
     if touching.len() < pairs.len() {
         touching.resize(pairs.len(), 0);
         released.resize(pairs.len(), 0);
     }
     let (mut nt, mut nr) = (0, 0);
-    for (k, (pair, h)) in pairs.iter().zip(hist).enumerate() {
+    for (k, (pair, &was)) in pairs.iter().zip(active).enumerate() {
         let (i, j) = (pair[0] as usize, pair[1] as usize);
         let d = boundary.image(p.x[i] - p.x[j]);
         let radsum = p.r[i] + p.r[j];
@@ -311,7 +314,7 @@ pub fn sort_pairs<H>(p: &Particles, boundary: &Boundary, pairs: &[[u32; 2]], his
         touching[nt] = k as u32;
         released[nr] = k as u32;
         nt += (touch & mine) as usize;
-        nr += (!touch & h.active & mine) as usize;
+        nr += (!touch & was & mine) as usize;
     }
     (nt, nr)
 }
@@ -329,7 +332,7 @@ pub fn compute_pairs<Dm: Damping, T: Tangential, const ENERGY: bool>(
     mut ledgers: Ledgers<'_>,
     out: &mut Vec<PairOut>,
 ) {
-    let PairSlices { pairs, consts, hist } = list;
+    let PairSlices { pairs, consts, hist, active } = list;
     if out.len() < touching.len() {
         out.resize(touching.len(), PairOut::default());
     }
@@ -339,7 +342,7 @@ pub fn compute_pairs<Dm: Damping, T: Tangential, const ENERGY: bool>(
         while a < touching.len() || b < released.len() {
             let touch = b == released.len() || (a < touching.len() && touching[a] < released[b]);
             let k = if touch { touching[a] } else { released[b] } as usize;
-            let o = pair_contact::<Dm, T, ENERGY>(w, pairs[k], &consts[k], &mut hist[k], ledgers.get(k));
+            let o = pair_contact::<Dm, T, ENERGY>(w, pairs[k], &consts[k], &mut hist[k], &mut active[k], ledgers.get(k));
             if touch {
                 out[a] = o;
                 a += 1;
@@ -353,16 +356,16 @@ pub fn compute_pairs<Dm: Damping, T: Tangential, const ENERGY: bool>(
     // One material: its lanes once, not a table lookup per lane.
     let single = w.pair_table.single().map(|m| PairMaterial::gather([m; LANES]));
     for (ks, o) in touching[..quads].chunks_exact(LANES).zip(out.chunks_exact_mut(LANES)) {
-        four_pairs(w, PairSlices::<T> { pairs, consts, hist: &mut *hist }, single.as_ref(), ks, o);
+        four_pairs(w, PairSlices::<T> { pairs, consts, hist: &mut *hist, active: &mut *active }, single.as_ref(), ks, o);
     }
     let mut none = EnergyLedger::default();
     for (m, &k) in touching.iter().enumerate().skip(quads) {
         let k = k as usize;
-        out[m] = pair_contact::<Dm, T, false>(w, pairs[k], &consts[k], &mut hist[k], &mut none);
+        out[m] = pair_contact::<Dm, T, false>(w, pairs[k], &consts[k], &mut hist[k], &mut active[k], &mut none);
     }
     for &k in released {
         let k = k as usize;
-        pair_contact::<Dm, T, false>(w, pairs[k], &consts[k], &mut hist[k], &mut none);
+        pair_contact::<Dm, T, false>(w, pairs[k], &consts[k], &mut hist[k], &mut active[k], &mut none);
     }
 }
 
@@ -395,10 +398,10 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
         let mut f = std::mem::take(&mut w.p.f);
         let mut torque = std::mem::take(&mut w.p.torque);
         let (pairs, consts) = (&w.pairs.pairs, &w.pairs.consts);
-        let (nt, nr) = sort_pairs(&w.p, &w.boundary, pairs, &w.pairs.hist, None, &mut self.touching, &mut self.released);
+        let (nt, nr) = sort_pairs(&w.p, &w.boundary, pairs, &w.pairs.active, None, &mut self.touching, &mut self.released);
         let (touching, released) = (&self.touching[..nt], &self.released[..nr]);
         let view = PairView { p: &w.p, boundary: w.boundary, law: w.law, pair_table: &w.pair_table, dt: w.dt };
-        let list = PairSlices::<T> { pairs, consts, hist: &mut w.pairs.hist };
+        let list = PairSlices::<T> { pairs, consts, hist: &mut w.pairs.hist, active: &mut w.pairs.active };
         compute_pairs::<Dm, T, ENERGY>(&view, list, touching, released, Ledgers::One(&mut w.ledger), &mut self.out);
         for (&k, o) in touching.iter().zip(&self.out) {
             let pair = pairs[k as usize];
@@ -437,7 +440,7 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
             if !wall.is_flat() {
                 continue;
             }
-            let hist = &mut w.wall_hist[k];
+            let (hist, active) = (&mut w.wall_hist[k], &mut w.wall_active[k]);
             let n = Vec2::new(0.0, wall.side);
             let mut on_wall = Vec2::zeros();
             for i in 0..p.n_free {
@@ -445,10 +448,11 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
                 let gap = wall.side * (p.x[i].y - wall.y);
                 let ri = p.r[i];
                 if gap >= ri {
-                    if h.active {
+                    if active[i] {
                         let spin = if T::FRICTION { ri * p.omega[i] } else { 0.0 };
                         let vc = p.v[i] - wall.v + spin * Vec2::new(n.y, -n.x);
                         model.release::<ENERGY>(vc, n, dt, h, &mut w.ledger);
+                        active[i] = false;
                     }
                     continue;
                 }
@@ -458,6 +462,7 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
                 let input = ContactInput { n, dn, r_star: ri, m_star: p.m[i], v_rel: p.v[i] - wall.v, spin, dt, tangential_scale: 1.0 };
                 let pm = w.pair_table.get(p.material[i] as usize, w.wall_material);
                 let c = model.touch::<ENERGY>(&input, pm, h, &mut w.ledger);
+                active[i] = true;
                 p.f[i] += c.force;
                 on_wall -= c.force;
                 if T::FRICTION {

@@ -29,6 +29,8 @@ pub struct World<L: ContactLaw> {
     pub walls: Vec<Wall>,
     /// History of each free grain against each flat wall: `wall_hist[wall][grain]`.
     pub wall_hist: Vec<Vec<Hist<L>>>,
+    /// Whether each free grain is touching each flat wall: `wall_active[wall][grain]`.
+    pub wall_active: Vec<Vec<bool>>,
     pub neighbours: Neighbours,
     pub ledger: EnergyLedger,
     pub gravity: Vec2,

@@ -140,13 +140,13 @@ pub struct ContactForce {
     pub kn: f64,
 }
 
-/// What a contact remembers from step to step.
+/// What a contact remembers from step to step. Whether it is touching is kept beside
+/// it, densely ([`crate::neighbor::PairList::active`], `World::wall_active`): the sweep
+/// that looks for contacts ending reads that flag for every listed pair.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct ContactHistory<H> {
     /// The tangential formulation's state.
     pub tangential: H,
-    /// True while the contact is (or was at the previous step) touching.
-    pub active: bool,
     /// Previous normal damping force (for the trapezoidal energy integrals), N.
     pub fd_prev: f64,
     /// Previous elastic tangential force, N.
@@ -250,7 +250,6 @@ impl<Dm: Damping, T: Tangential> ContactModel<Dm, T> {
             }
             h.fd_prev = fd;
         }
-        h.active = true;
         ContactForce { force: s.force, tangential: tf.elastic + tf.damping, normal: s.normal, kn: s.kn }
     }
 
