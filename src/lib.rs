@@ -14,13 +14,15 @@
 //!    from the measured convergence of an impact ([`accuracy`]).
 //! 3. **Contact physics** ([`contact`]) is composed at compile time: Hertz normal force,
 //!    a damping form, a tangential formulation (LIGGGHTS' total displacement or YADE's
-//!    increments), one monomorphized kernel per named combination. Neighbours come
-//!    from a cell list with a skin, and contact history survives rebuilds ([`neighbor`]);
-//!    x may be periodic ([`boundary`]); walls are flat or rough, fixed or loaded ([`walls`]).
+//!    increments), one monomorphized kernel per named combination. The law is written
+//!    once, generic over its number type, and runs one contact or four in SIMD lanes with
+//!    the same bits ([`lanes`]). Neighbours come from a cell list with a skin, and
+//!    contact history survives rebuilds ([`neighbor`]); x may be periodic ([`boundary`]);
+//!    walls are flat or rough, fixed or loaded ([`walls`]).
 //! 4. **Simulation** ([`sim`]): velocity Verlet ([`integrate`]) runs the stages each step,
 //!    timed per stage; a watchdog stops a run that goes unstable, with a diagnosis.
-//!    With the `parallel` feature the contact forces run on several threads, bit for bit
-//!    the same as on one ([`parallel`]).
+//!    With the `parallel` feature the per-grain stages and the contact forces run on
+//!    several threads ([`threads`], [`parallel`]), bit for bit the same as on one.
 //! 5. **Observers** ([`observe`]): the energy balance, impact measurements, wall stresses,
 //!    with block-averaged confidence intervals ([`stats`]).
 //! 6. **Output** ([`output`]): `summary.json`, CSV time series with unit-suffixed headers,

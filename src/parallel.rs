@@ -19,7 +19,7 @@ use crate::contact::damping::Damping;
 use crate::contact::tangential::Tangential;
 use crate::error::Error;
 use crate::observe::energy::EnergyLedger;
-use crate::pipeline::{Ledgers, PairOut, PairSlices, PairView, Stage, compute_pairs, pair_contact, sort_pairs};
+use crate::pipeline::{Ledgers, PairOut, PairSlices, PairView, Pending, Stage, compute_pairs, pair_contact, sort_pairs};
 use crate::sim::World;
 use crate::threads::Threads;
 
@@ -31,6 +31,7 @@ struct Scratch {
     touching: Vec<u32>,
     released: Vec<u32>,
     out: Vec<PairOut>,
+    pending: Vec<Pending>,
     /// Largest overlap ratio of the part and its pair index.
     worst: (f64, usize),
 }
@@ -189,7 +190,7 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
                 let mut none = EnergyLedger::default();
                 let l = if ENERGY { Ledgers::PerPair(ledgers) } else { Ledgers::One(&mut none) };
                 let list = PairSlices::<T> { pairs: &pairs[part.clone()], consts: &consts[part.clone()], hist, active };
-                compute_pairs::<Dm, T, ENERGY>(&view, list, &sc.touching[..nt], &sc.released[..nr], l, &mut sc.out);
+                compute_pairs::<Dm, T, ENERGY>(&view, list, &sc.touching[..nt], &sc.released[..nr], l, &mut sc.out, &mut sc.pending);
                 let mut best = (0.0, usize::MAX);
                 let mut add = |k: usize, o: &PairOut, own: bool| {
                     let (i, j) = (pairs[k][0] as usize - g0, pairs[k][1] as usize);

@@ -241,7 +241,14 @@ pub fn pair_contact<Dm: Damping, T: Tangential, const ENERGY: bool>(
 /// Four touching pairs at once, one per SIMD lane (`ks`: their indices in the list);
 /// the same bits as [`pair_contact`] gives each of them, without the energy ledger.
 #[inline(always)]
-fn four_pairs<Dm: Damping, T: Tangential>(w: &PairView<'_, ContactModel<Dm, T>>, list: PairSlices<'_, T>, single: Option<&PairMaterial<Lanes>>, ks: &[u32], out: &mut [PairOut]) {
+fn four_pairs<Dm: Damping, T: Tangential, const ENERGY: bool>(
+    w: &PairView<'_, ContactModel<Dm, T>>,
+    list: PairSlices<'_, T>,
+    single: Option<&PairMaterial<Lanes>>,
+    ks: &[u32],
+    out: &mut [PairOut],
+    pending: &mut [Pending],
+) {
     let (model, p) = (w.law, w.p);
     let lever = model.options.lever_arm;
     let ij: [(usize, usize); LANES] = std::array::from_fn(|l| {
@@ -266,7 +273,35 @@ fn four_pairs<Dm: Damping, T: Tangential>(w: &PairView<'_, ContactModel<Dm, T>>,
         list.hist[ks[l] as usize].tangential = T::lane(&h, l);
         list.active[ks[l] as usize] = true;
         out[l] = PairOut { force: lane2(&c.force, l), torque: [torque[0].extract(l), torque[1].extract(l)], ratio: ratio.extract(l) };
+        if ENERGY {
+            pending[l] = Pending { n: lane2(&input.n, l), dn: input.dn.extract(l), state: c.lane(l) };
+        }
     }
+}
+
+/// One touching pair (list index `k`) as [`four_pairs`] computes each of its four.
+#[inline(always)]
+fn one_pair<Dm: Damping, T: Tangential>(w: &PairView<'_, ContactModel<Dm, T>>, list: &mut PairSlices<'_, T>, k: usize) -> (PairOut, Pending) {
+    let (model, p) = (w.law, w.p);
+    let lever = model.options.lever_arm;
+    let (i, j) = (list.pairs[k][0] as usize, list.pairs[k][1] as usize);
+    let pc = &list.consts[k];
+    let d = w.boundary.image(p.x[i] - p.x[j]);
+    let input = pair_input::<f64, T>(lever, d, p.r[i], p.r[j], p.omega[i], p.omega[j], p.v[i] - p.v[j], pc.r_star, pc.m_star, w.dt);
+    let pm = w.pair_table.get(p.material[i] as usize, p.material[j] as usize);
+    let c = model.force(&input, pm, &mut list.hist[k].tangential);
+    list.active[k] = true;
+    let torque = if T::FRICTION { pair_torque(lever, &input, c.tangential.elastic + c.tangential.damping, p.r[i], p.r[j]) } else { [0.0, 0.0] };
+    (PairOut { force: c.force, torque, ratio: input.dn * pc.inv_r_min }, Pending { n: input.n, dn: input.dn, state: c })
+}
+
+/// What a touching pair's energy accounting needs, kept until the pairs are accounted in
+/// list order: the normal, the overlap (m), and the step's contact state.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Pending {
+    n: Vec2,
+    dn: f64,
+    state: crate::contact::model::ContactState,
 }
 
 /// A part of the pair list: the pairs, their constants, histories and touching flags.
@@ -321,51 +356,62 @@ pub fn sort_pairs(p: &Particles, boundary: &Boundary, pairs: &[[u32; 2]], active
 
 /// Compute the pairs `touching` and `released` of a list part (indices from
 /// [`sort_pairs`]): the output of `touching[m]` goes to `out[m]` (`out` keeps its
-/// length from step to step; it grows when needed). Without the energy ledger the
-/// touching pairs run four at a time in SIMD lanes; with it, one by one with the
-/// released ones in list order, so that the ledger sums in the serial order.
+/// length from step to step; it grows when needed). The touching pairs run four at a
+/// time in SIMD lanes. With the energy ledger, their accounting (and the released pairs')
+/// then follows in list order, so that the ledger sums in the serial order; `pending`
+/// holds what it needs meanwhile.
+#[allow(clippy::too_many_arguments)]
 pub fn compute_pairs<Dm: Damping, T: Tangential, const ENERGY: bool>(
     w: &PairView<'_, ContactModel<Dm, T>>,
-    list: PairSlices<'_, T>,
+    mut list: PairSlices<'_, T>,
     touching: &[u32],
     released: &[u32],
     mut ledgers: Ledgers<'_>,
     out: &mut Vec<PairOut>,
+    pending: &mut Vec<Pending>,
 ) {
-    let PairSlices { pairs, consts, hist, active } = list;
     if out.len() < touching.len() {
         out.resize(touching.len(), PairOut::default());
     }
-    if ENERGY {
-        // Both kinds merged in list order: the ledger is a sum.
-        let (mut a, mut b) = (0, 0);
-        while a < touching.len() || b < released.len() {
-            let touch = b == released.len() || (a < touching.len() && touching[a] < released[b]);
-            let k = if touch { touching[a] } else { released[b] } as usize;
-            let o = pair_contact::<Dm, T, ENERGY>(w, pairs[k], &consts[k], &mut hist[k], &mut active[k], ledgers.get(k));
-            if touch {
-                out[a] = o;
-                a += 1;
-            } else {
-                b += 1;
-            }
-        }
-        return;
+    if ENERGY && pending.len() < touching.len() {
+        pending.resize(touching.len(), Pending::default());
     }
     let quads = touching.len() / LANES * LANES;
     // One material: its lanes once, not a table lookup per lane.
     let single = w.pair_table.single().map(|m| PairMaterial::gather([m; LANES]));
+    let mut pend = pending.chunks_exact_mut(LANES);
     for (ks, o) in touching[..quads].chunks_exact(LANES).zip(out.chunks_exact_mut(LANES)) {
-        four_pairs(w, PairSlices::<T> { pairs, consts, hist: &mut *hist, active: &mut *active }, single.as_ref(), ks, o);
+        let slices = PairSlices::<T> { pairs: list.pairs, consts: list.consts, hist: &mut *list.hist, active: &mut *list.active };
+        four_pairs::<Dm, T, ENERGY>(w, slices, single.as_ref(), ks, o, if ENERGY { pend.next().expect("a slot per pair") } else { &mut [] });
     }
-    let mut none = EnergyLedger::default();
     for (m, &k) in touching.iter().enumerate().skip(quads) {
-        let k = k as usize;
-        out[m] = pair_contact::<Dm, T, false>(w, pairs[k], &consts[k], &mut hist[k], &mut active[k], &mut none);
+        let (o, p) = one_pair(w, &mut list, k as usize);
+        out[m] = o;
+        if ENERGY {
+            pending[m] = p;
+        }
     }
-    for &k in released {
-        let k = k as usize;
-        pair_contact::<Dm, T, false>(w, pairs[k], &consts[k], &mut hist[k], &mut active[k], &mut none);
+    let PairSlices { pairs, consts, hist, active } = list;
+    let mut none = EnergyLedger::default();
+    if !ENERGY {
+        for &k in released {
+            let k = k as usize;
+            pair_contact::<Dm, T, false>(w, pairs[k], &consts[k], &mut hist[k], &mut active[k], &mut none);
+        }
+        return;
+    }
+    // Both kinds merged in list order: the ledger is a sum.
+    let (mut a, mut b) = (0, 0);
+    while a < touching.len() || b < released.len() {
+        if b == released.len() || (a < touching.len() && touching[a] < released[b]) {
+            let (k, p) = (touching[a] as usize, &pending[a]);
+            w.law.account(p.n, p.dn, w.dt, &p.state, &mut hist[k], ledgers.get(k));
+            a += 1;
+        } else {
+            let k = released[b] as usize;
+            pair_contact::<Dm, T, true>(w, pairs[k], &consts[k], &mut hist[k], &mut active[k], ledgers.get(k));
+            b += 1;
+        }
     }
 }
 
@@ -387,6 +433,7 @@ pub struct PairForces<const ENERGY: bool> {
     touching: Vec<u32>,
     released: Vec<u32>,
     out: Vec<PairOut>,
+    pending: Vec<Pending>,
 }
 
 impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> for PairForces<ENERGY> {
@@ -402,7 +449,7 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
         let (touching, released) = (&self.touching[..nt], &self.released[..nr]);
         let view = PairView { p: &w.p, boundary: w.boundary, law: w.law, pair_table: &w.pair_table, dt: w.dt };
         let list = PairSlices::<T> { pairs, consts, hist: &mut w.pairs.hist, active: &mut w.pairs.active };
-        compute_pairs::<Dm, T, ENERGY>(&view, list, touching, released, Ledgers::One(&mut w.ledger), &mut self.out);
+        compute_pairs::<Dm, T, ENERGY>(&view, list, touching, released, Ledgers::One(&mut w.ledger), &mut self.out, &mut self.pending);
         for (&k, o) in touching.iter().zip(&self.out) {
             let pair = pairs[k as usize];
             let (i, j) = (pair[0] as usize, pair[1] as usize);

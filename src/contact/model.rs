@@ -110,7 +110,7 @@ impl<R: Real> ContactInput<R> {
 
 /// Everything one step of a touching contact computes: the force, and what the energy
 /// accounting reads.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, Default)]
 pub struct ContactState<R: Real = f64> {
     /// Total force on i, N.
     pub force: Vector2<R>,
@@ -125,6 +125,25 @@ pub struct ContactState<R: Real = f64> {
     pub kt: R,
     /// Relative velocity of the contact points, m/s.
     pub vc: Vector2<R>,
+}
+
+impl ContactState<crate::lanes::Lanes> {
+    /// The state of the contact in lane `l`.
+    #[inline(always)]
+    pub fn lane(&self, l: usize) -> ContactState {
+        use crate::lanes::lane2;
+        use simba::simd::SimdValue;
+        let t = &self.tangential;
+        ContactState {
+            force: lane2(&self.force, l),
+            tangential: TangentialForce { elastic: lane2(&t.elastic, l), damping: lane2(&t.damping, l), slip_energy: t.slip_energy.extract(l) },
+            normal: self.normal.extract(l),
+            elastic_normal: self.elastic_normal.extract(l),
+            kn: self.kn.extract(l),
+            kt: self.kt.extract(l),
+            vc: lane2(&self.vc, l),
+        }
+    }
 }
 
 /// The force of one contact on grain i (grain j gets the opposite).
@@ -231,26 +250,35 @@ impl<Dm: Damping, T: Tangential> ContactModel<Dm, T> {
         ledger: &mut EnergyLedger,
     ) -> ContactForce {
         let s = self.force(c, pm, &mut h.tangential);
-        let tf = s.tangential;
         if ENERGY {
-            let dc = s.vc * c.dt;
-            let fd = s.normal - s.elastic_normal;
-            ledger.normal_damping -= 0.5 * (h.fd_prev + fd) * dc.dot(&c.n);
-            ledger.elastic_normal += hertz_energy(s.kn, c.dn);
-            if T::FRICTION {
-                let ut = if s.kt > 0.0 { 0.5 * tf.elastic.norm_squared() / s.kt } else { 0.0 };
-                ledger.tangential_damping -= 0.5 * (h.ftd_prev + tf.damping).dot(&dc);
-                let w_spring = 0.5 * (h.fte_prev + tf.elastic).dot(&dc);
-                ledger.friction += tf.slip_energy;
-                ledger.tangential_model += ut - h.ut_prev + tf.slip_energy + w_spring;
-                ledger.elastic_tangential += ut;
-                h.fte_prev = tf.elastic;
-                h.ftd_prev = tf.damping;
-                h.ut_prev = ut;
-            }
-            h.fd_prev = fd;
+            self.account(c.n, c.dn, c.dt, &s, h, ledger);
         }
+        let tf = s.tangential;
         ContactForce { force: s.force, tangential: tf.elastic + tf.damping, normal: s.normal, kn: s.kn }
+    }
+
+    /// The trapezoidal work integrals of one step of a touching contact (normal `n`,
+    /// overlap `dn`, m, time step `dt`, s), from what [`ContactModel::force`] computed,
+    /// into `ledger`; the previous-step values in `h` move on.
+    #[inline(always)]
+    pub fn account(&self, n: Vec2, dn: f64, dt: f64, s: &ContactState, h: &mut ContactHistory<T::History<f64>>, ledger: &mut EnergyLedger) {
+        let tf = s.tangential;
+        let dc = s.vc * dt;
+        let fd = s.normal - s.elastic_normal;
+        ledger.normal_damping -= 0.5 * (h.fd_prev + fd) * dc.dot(&n);
+        ledger.elastic_normal += hertz_energy(s.kn, dn);
+        if T::FRICTION {
+            let ut = if s.kt > 0.0 { 0.5 * tf.elastic.norm_squared() / s.kt } else { 0.0 };
+            ledger.tangential_damping -= 0.5 * (h.ftd_prev + tf.damping).dot(&dc);
+            let w_spring = 0.5 * (h.fte_prev + tf.elastic).dot(&dc);
+            ledger.friction += tf.slip_energy;
+            ledger.tangential_model += ut - h.ut_prev + tf.slip_energy + w_spring;
+            ledger.elastic_tangential += ut;
+            h.fte_prev = tf.elastic;
+            h.ftd_prev = tf.damping;
+            h.ut_prev = ut;
+        }
+        h.fd_prev = fd;
     }
 
     /// A contact that was touching at the previous step and is not any more: close its
