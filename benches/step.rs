@@ -5,6 +5,7 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use grainlab::boundary::Boundary;
 use grainlab::build;
 use grainlab::neighbor::cell_pairs;
+use grainlab::threads::Threads;
 use grainlab::scene::TangentialSpec;
 use grainlab::scenes::shear;
 
@@ -35,7 +36,7 @@ fn neighbour_rebuild(c: &mut Criterion) {
     let p = built.engine.particles();
     let b: Boundary = built.engine.boundary();
     let (mut cs, mut ci) = (Vec::new(), Vec::new());
-    c.bench_function("cell_list_rebuild_1000_grains", |bch| bch.iter(|| cell_pairs(&p.x, &p.r, p.n_free, &b, 1e-4, &mut cs, &mut ci)));
+    c.bench_function("cell_list_rebuild_1000_grains", |bch| bch.iter(|| cell_pairs(&p.x, &p.r, p.n_free, &b, 1e-4, &mut cs, &mut ci, &Threads::serial())));
 }
 
 fn contact_kernel(c: &mut Criterion) {

@@ -119,7 +119,7 @@ impl Neighbours {
         self.moved_far = false;
         self.x_at_build.clear();
         self.x_at_build.extend_from_slice(x);
-        cell_pairs_on(x, r, n_free, boundary, self.skin, &mut self.cell_start, &mut self.cell_items, threads)
+        cell_pairs(x, r, n_free, boundary, self.skin, &mut self.cell_start, &mut self.cell_items, threads)
     }
 }
 
@@ -145,23 +145,11 @@ pub fn brute_force_pairs(x: &[Vec2], r: &[f64], n_free: usize, boundary: &Bounda
     out
 }
 
-/// All pairs closer than the skin, with a cell list. Sorted, i < j.
-pub fn cell_pairs(
-    x: &[Vec2],
-    r: &[f64],
-    n_free: usize,
-    boundary: &Boundary,
-    skin: f64,
-    cell_start: &mut Vec<u32>,
-    cell_items: &mut Vec<u32>,
-) -> Vec<[u32; 2]> {
-    cell_pairs_on(x, r, n_free, boundary, skin, cell_start, cell_items, &Threads::serial())
-}
-
-/// [`cell_pairs`] on `threads`: each thread lists the pairs (i, j > i) of its own grains
-/// i, already in order, so the parts join into the sorted list with no sort.
+/// All pairs closer than the skin, with a cell list. Sorted, i < j. Each of `threads`
+/// lists the pairs (i, j > i) of its own grains i, already in order, so the parts join
+/// into the sorted list with no sort.
 #[allow(clippy::too_many_arguments)]
-pub fn cell_pairs_on(
+pub fn cell_pairs(
     x: &[Vec2],
     r: &[f64],
     n_free: usize,

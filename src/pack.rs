@@ -14,6 +14,7 @@ use crate::boundary::Boundary;
 use crate::dim::Vec2;
 use crate::error::{Error, check};
 use crate::neighbor::cell_pairs;
+use crate::threads::Threads;
 
 /// A distribution of radii, m. Normal and lognormal draws are truncated to [min, max].
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -93,7 +94,7 @@ pub fn relaxed_packing(r: &[f64], x0: f64, x1: f64, y0: f64, y1: f64, periodic: 
     let mut moves = vec![Vec2::zeros(); x.len()];
     for _ in 0..2000 {
         if moved > 0.5 * skin {
-            pairs = cell_pairs(&x, r, r.len(), &boundary, skin, &mut cs, &mut ci);
+            pairs = cell_pairs(&x, r, r.len(), &boundary, skin, &mut cs, &mut ci, &Threads::serial());
             moved = 0.0;
         }
         let mut worst: f64 = 0.0;

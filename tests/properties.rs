@@ -4,6 +4,7 @@
 use grainlab::boundary::Boundary;
 use grainlab::dim::Vec2;
 use grainlab::neighbor::{brute_force_pairs, cell_pairs};
+use grainlab::threads::Threads;
 use proptest::prelude::*;
 
 fn packing() -> impl Strategy<Value = (Vec<Vec2>, Vec<f64>, usize, bool, f64)> {
@@ -28,7 +29,7 @@ proptest! {
         let side = x.iter().map(|p| p.x).fold(0.0, f64::max) + 1e-9;
         let b = if periodic { Boundary::periodic_x(0.0, side) } else { Boundary::open() };
         let brute = brute_force_pairs(&x, &r, n_free, &b, skin);
-        let cells = cell_pairs(&x, &r, n_free, &b, skin, &mut Vec::new(), &mut Vec::new());
+        let cells = cell_pairs(&x, &r, n_free, &b, skin, &mut Vec::new(), &mut Vec::new(), &Threads::serial());
         prop_assert_eq!(cells, brute);
     }
 }
