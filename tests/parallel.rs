@@ -37,3 +37,35 @@ fn two_threads_give_the_same_bits_as_one() {
         assert_eq!(ea.tangential_model_work_j.to_bits(), eb.tangential_model_work_j.to_bits());
     }
 }
+
+#[test]
+fn the_pool_gives_every_grain_once_keeps_parts_on_their_threads_and_passes_panics_on() {
+    use grainlab::threads::Threads;
+    use std::panic::{AssertUnwindSafe, catch_unwind};
+    use std::sync::Mutex;
+    let t = Threads::new(2).unwrap();
+    assert_eq!(t.count(), 2);
+    // Every index exactly once per hand-over, over many hand-overs (the spin-wait epochs).
+    let mut v = vec![0u32; 10_000];
+    for _ in 0..2000 {
+        t.split(v.len(), &mut v[..], |part| part.iter_mut().for_each(|x| *x += 1));
+    }
+    assert!(v.iter().all(|&x| x == 2000), "each grain once per step");
+    // Part r always runs on the same thread (its grains stay in that thread's cache).
+    let seen = Mutex::new(vec![Vec::new(); 2]);
+    for _ in 0..50 {
+        t.each(vec![(), ()], |r, _| seen.lock().unwrap()[r].push(std::thread::current().id()));
+    }
+    let seen = seen.into_inner().unwrap();
+    for ids in &seen {
+        assert!(ids.iter().all(|id| *id == ids[0]));
+    }
+    assert_ne!(seen[0][0], seen[1][0], "two threads, not one");
+    // A panic on either thread reaches the caller, and the pool still works afterwards.
+    for bad in 0..2 {
+        let r = catch_unwind(AssertUnwindSafe(|| t.each(vec![(), ()], |r, _| assert_ne!(r, bad, "thread {r} fails on purpose"))));
+        assert!(r.is_err(), "a panic on thread {bad} is passed on");
+    }
+    t.split(v.len(), &mut v[..], |part| part.iter_mut().for_each(|x| *x += 1));
+    assert!(v.iter().all(|&x| x == 2001));
+}
