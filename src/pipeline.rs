@@ -1,7 +1,9 @@
 //! The step pipeline: the stages a scene asks for, in order, and nothing else.
 //!
 //! A scene without walls has no wall stages, without gravity no gravity stage, without
-//! friction no spin update, without periodicity no wrap; `explain` prints the list.
+//! friction no spin update; `explain` prints the list. (The periodic wrap rides along
+//! the drift, [`crate::integrate::InitialIntegrate`], and costs a branch without
+//! periodicity.)
 
 use nalgebra::Vector2;
 use simba::simd::SimdValue;
@@ -213,7 +215,6 @@ pub fn pair_contact<Dm: Damping, T: Tangential, const ENERGY: bool>(
     ledger: &mut EnergyLedger,
 ) -> PairOut {
     let model = w.law;
-    let lever = model.options.lever_arm;
     let p = w.p;
     let (i, j) = (pair[0] as usize, pair[1] as usize);
     let d = w.boundary.image(p.x[i] - p.x[j]);
@@ -230,16 +231,16 @@ pub fn pair_contact<Dm: Damping, T: Tangential, const ENERGY: bool>(
         }
         return PairOut::default();
     }
-    let input = pair_input::<f64, T>(lever, d, ri, rj, p.omega[i], p.omega[j], p.v[i] - p.v[j], pc.r_star, pc.m_star, w.dt);
-    let pm = w.pair_table.get(p.material[i] as usize, p.material[j] as usize);
-    let c = model.touch::<ENERGY>(&input, pm, h, ledger);
-    *active = true;
-    let torque = if T::FRICTION { pair_torque(lever, &input, c.tangential, ri, rj) } else { [0.0, 0.0] };
-    PairOut { force: c.force, torque, ratio: input.dn * pc.inv_r_min }
+    let (o, pend) = one_pair(w, (i, j), d, pc, &mut h.tangential, active);
+    if ENERGY {
+        model.account(pend.n, pend.dn, w.dt, &pend.state, h, ledger);
+    }
+    o
 }
 
-/// Four touching pairs at once, one per SIMD lane (`ks`: their indices in the list);
-/// the same bits as [`pair_contact`] gives each of them, without the energy ledger.
+/// Four touching pairs at once, one per SIMD lane (`ks`: their indices in the list):
+/// the same bits as [`one_pair`] gives each of them; with `ENERGY`, what their
+/// accounting needs goes to `pending`.
 #[inline(always)]
 fn four_pairs<Dm: Damping, T: Tangential, const ENERGY: bool>(
     w: &PairView<'_, ContactModel<Dm, T>>,
@@ -279,18 +280,23 @@ fn four_pairs<Dm: Damping, T: Tangential, const ENERGY: bool>(
     }
 }
 
-/// One touching pair (list index `k`) as [`four_pairs`] computes each of its four.
+/// One touching pair of grains `(i, j)` at separation `d` (minimum image, i minus j):
+/// its force, advancing its tangential state `h`, and what its energy accounting needs.
 #[inline(always)]
-fn one_pair<Dm: Damping, T: Tangential>(w: &PairView<'_, ContactModel<Dm, T>>, list: &mut PairSlices<'_, T>, k: usize) -> (PairOut, Pending) {
+fn one_pair<Dm: Damping, T: Tangential>(
+    w: &PairView<'_, ContactModel<Dm, T>>,
+    (i, j): (usize, usize),
+    d: Vec2,
+    pc: &PairConst,
+    h: &mut T::History<f64>,
+    active: &mut bool,
+) -> (PairOut, Pending) {
     let (model, p) = (w.law, w.p);
     let lever = model.options.lever_arm;
-    let (i, j) = (list.pairs[k][0] as usize, list.pairs[k][1] as usize);
-    let pc = &list.consts[k];
-    let d = w.boundary.image(p.x[i] - p.x[j]);
     let input = pair_input::<f64, T>(lever, d, p.r[i], p.r[j], p.omega[i], p.omega[j], p.v[i] - p.v[j], pc.r_star, pc.m_star, w.dt);
     let pm = w.pair_table.get(p.material[i] as usize, p.material[j] as usize);
-    let c = model.force(&input, pm, &mut list.hist[k].tangential);
-    list.active[k] = true;
+    let c = model.force(&input, pm, h);
+    *active = true;
     let torque = if T::FRICTION { pair_torque(lever, &input, c.tangential.elastic + c.tangential.damping, p.r[i], p.r[j]) } else { [0.0, 0.0] };
     (PairOut { force: c.force, torque, ratio: input.dn * pc.inv_r_min }, Pending { n: input.n, dn: input.dn, state: c })
 }
@@ -363,7 +369,7 @@ pub fn sort_pairs(p: &Particles, boundary: &Boundary, pairs: &[[u32; 2]], active
 #[allow(clippy::too_many_arguments)]
 pub fn compute_pairs<Dm: Damping, T: Tangential, const ENERGY: bool>(
     w: &PairView<'_, ContactModel<Dm, T>>,
-    mut list: PairSlices<'_, T>,
+    list: PairSlices<'_, T>,
     touching: &[u32],
     released: &[u32],
     mut ledgers: Ledgers<'_>,
@@ -379,19 +385,22 @@ pub fn compute_pairs<Dm: Damping, T: Tangential, const ENERGY: bool>(
     let quads = touching.len() / LANES * LANES;
     // One material: its lanes once, not a table lookup per lane.
     let single = w.pair_table.single().map(|m| PairMaterial::gather([m; LANES]));
+    let PairSlices { pairs, consts, hist, active } = list;
     let mut pend = pending.chunks_exact_mut(LANES);
     for (ks, o) in touching[..quads].chunks_exact(LANES).zip(out.chunks_exact_mut(LANES)) {
-        let slices = PairSlices::<T> { pairs: list.pairs, consts: list.consts, hist: &mut *list.hist, active: &mut *list.active };
+        let slices = PairSlices::<T> { pairs, consts, hist: &mut *hist, active: &mut *active };
         four_pairs::<Dm, T, ENERGY>(w, slices, single.as_ref(), ks, o, if ENERGY { pend.next().expect("a slot per pair") } else { &mut [] });
     }
     for (m, &k) in touching.iter().enumerate().skip(quads) {
-        let (o, p) = one_pair(w, &mut list, k as usize);
+        let k = k as usize;
+        let (i, j) = (pairs[k][0] as usize, pairs[k][1] as usize);
+        let d = w.boundary.image(w.p.x[i] - w.p.x[j]);
+        let (o, p) = one_pair(w, (i, j), d, &consts[k], &mut hist[k].tangential, &mut active[k]);
         out[m] = o;
         if ENERGY {
             pending[m] = p;
         }
     }
-    let PairSlices { pairs, consts, hist, active } = list;
     let mut none = EnergyLedger::default();
     if !ENERGY {
         for &k in released {
