@@ -367,6 +367,7 @@ impl Parts<'_> {
             initial_energy: 0.0,
             energy: E,
             threads: self.threads.clone(),
+            kick: Default::default(),
         };
         // The force stages, shared by the step and by the set-up at t = 0.
         let threads = self.threads.clone();
@@ -398,9 +399,9 @@ impl Parts<'_> {
             stages.push(Box::new(FinishWalls::<E>));
         }
         if rotation {
-            stages.push(Box::new(FinalIntegrate::<true>::default()));
+            stages.push(Box::new(FinalIntegrate::<true>));
         } else {
-            stages.push(Box::new(FinalIntegrate::<false>::default()));
+            stages.push(Box::new(FinalIntegrate::<false>));
         }
         stages.push(Box::new(Watchdog { max_overlap: 0.1, every: 100 }));
         let mut setup = forces()?;

@@ -17,7 +17,8 @@ use crate::sim::World;
 
 /// The half-kick factors `dt/2 / m` and `dt/2 / I` of the free grains, divided out once
 /// per time step value instead of at every step (the same division, so the same bits as
-/// LIGGGHTS' `dtfm = dtf / rmass[i]`).
+/// LIGGGHTS' `dtfm = dtf / rmass[i]`). One set per world (`World::kick`), shared by both
+/// half kicks.
 #[derive(Default)]
 pub struct KickFactors {
     dt: f64,
@@ -28,7 +29,8 @@ pub struct KickFactors {
 }
 
 impl KickFactors {
-    fn update(&mut self, p: &Particles, dt: f64) {
+    /// Recompute for time step `dt` if it (or the number of free grains) changed.
+    pub fn update(&mut self, p: &Particles, dt: f64) {
         let n = p.n_free;
         if self.dt != dt || self.dtfm.len() != n {
             let dtf = 0.5 * dt;
@@ -44,7 +46,6 @@ impl KickFactors {
 /// watch (has a grain moved more than half the skin since the last build?).
 #[derive(Default)]
 pub struct InitialIntegrate<const ROT: bool> {
-    k: KickFactors,
     /// Stands in for the positions at the last build before there is a build.
     origin: Vec<Vec2>,
 }
@@ -57,7 +58,8 @@ impl<L: ContactLaw, const ROT: bool> Stage<L> for InitialIntegrate<ROT> {
         let dt = w.dt;
         let p = &mut w.p;
         let n = p.n_free;
-        self.k.update(p, dt);
+        let k = &mut w.kick;
+        k.update(p, dt);
         let (b, limit) = (w.boundary, w.neighbours.limit());
         let listed = w.neighbours.at_build().len() == p.len();
         if !listed {
@@ -66,8 +68,8 @@ impl<L: ContactLaw, const ROT: bool> Stage<L> for InitialIntegrate<ROT> {
         }
         let at = if listed { &w.neighbours.at_build()[..n] } else { &self.origin[..] };
         let far = AtomicBool::new(false);
-        let translation = (&mut p.v[..n], &mut p.x[..n], &p.f[..n], &self.k.dtfm[..], at);
-        let rotation = (&mut p.omega[..n], &mut p.theta[..n], &p.torque[..n], &self.k.dtfi[..]);
+        let translation = (&mut p.v[..n], &mut p.x[..n], &p.f[..n], &k.dtfm[..], at);
+        let rotation = (&mut p.omega[..n], &mut p.theta[..n], &p.torque[..n], &k.dtfi[..]);
         w.threads.split(n, (translation, rotation), |((v, x, f, dtfm, at), (omega, theta, torque, dtfi))| {
             for (((v, x), f), m) in v.iter_mut().zip(x.iter_mut()).zip(f).zip(dtfm) {
                 *v += *m * *f;
@@ -91,9 +93,7 @@ impl<L: ContactLaw, const ROT: bool> Stage<L> for InitialIntegrate<ROT> {
 
 /// Second half kick of the free grains.
 #[derive(Default)]
-pub struct FinalIntegrate<const ROT: bool> {
-    k: KickFactors,
-}
+pub struct FinalIntegrate<const ROT: bool>;
 
 impl<L: ContactLaw, const ROT: bool> Stage<L> for FinalIntegrate<ROT> {
     fn name(&self) -> String {
@@ -102,9 +102,10 @@ impl<L: ContactLaw, const ROT: bool> Stage<L> for FinalIntegrate<ROT> {
     fn run(&mut self, w: &mut World<L>) -> Result<(), Error> {
         let p = &mut w.p;
         let n = p.n_free;
-        self.k.update(p, w.dt);
-        let rotation = (&mut p.omega[..n], &p.torque[..n], &self.k.dtfi[..]);
-        w.threads.split(n, ((&mut p.v[..n], &p.f[..n], &self.k.dtfm[..]), rotation), |((v, f, dtfm), (omega, torque, dtfi))| {
+        let k = &mut w.kick;
+        k.update(p, w.dt);
+        let rotation = (&mut p.omega[..n], &p.torque[..n], &k.dtfi[..]);
+        w.threads.split(n, ((&mut p.v[..n], &p.f[..n], &k.dtfm[..]), rotation), |((v, f, dtfm), (omega, torque, dtfi))| {
             for ((v, f), m) in v.iter_mut().zip(f).zip(dtfm) {
                 *v += *m * *f;
             }

@@ -46,6 +46,8 @@ pub struct World<L: ContactLaw> {
     pub energy: bool,
     /// The threads the per-grain stages and the contact stage may use.
     pub threads: crate::threads::Threads,
+    /// The half-kick factors of the integrator.
+    pub kick: crate::integrate::KickFactors,
 }
 
 impl<L: ContactLaw> World<L> {
