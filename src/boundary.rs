@@ -3,7 +3,10 @@
 //! Without periodicity `period = 0` and `inv_period = 0`, so the minimum-image formula
 //! `dx - period * round(dx / period)` is the identity: no branch in the hot loop.
 
+use nalgebra::Vector2;
+
 use crate::dim::Vec2;
+use crate::lanes::Real;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Boundary {
@@ -24,10 +27,11 @@ impl Boundary {
     pub fn is_periodic(&self) -> bool {
         self.period > 0.0
     }
-    /// The minimum image of a separation vector.
+    /// The minimum image of a separation vector (or of four, in lanes).
     #[inline(always)]
-    pub fn image(&self, mut d: Vec2) -> Vec2 {
-        d.x -= self.period * nearest_integer(d.x * self.inv_period);
+    pub fn image<R: Real>(&self, mut d: Vector2<R>) -> Vector2<R> {
+        let s = nearest_integer(d.x * R::splat(self.inv_period));
+        d.x -= R::splat(self.period) * s;
         d
     }
     /// Bring a position back into [x_min, x_min + period).
@@ -37,7 +41,7 @@ impl Boundary {
         // Inside already (almost always: a predictable branch, no rounding).
         if self.period > 0.0 && !(xr >= 0.0 && xr < self.period) {
             let v = xr * self.inv_period;
-            let s = nearest_integer(v);
+            let s: f64 = nearest_integer(v);
             let s = if s > v { s - 1.0 } else { s };
             x.x -= s * self.period;
         }
@@ -48,10 +52,10 @@ impl Boundary {
 /// the C library's `round` (baseline x86-64 has no rounding instruction; this sits in
 /// the innermost loop). Exact for every finite `v`: from 2^51 on, `v` is an integer.
 #[inline(always)]
-pub fn nearest_integer(v: f64) -> f64 {
+pub fn nearest_integer<R: Real>(v: R) -> R {
     // 1.5 * 2^52: adding it leaves no fractional bits, so the sum is rounded to an integer.
-    const SHIFT: f64 = 6_755_399_441_055_744.0;
-    if v.abs() < 2_251_799_813_685_248.0 { (v + SHIFT) - SHIFT } else { v }
+    let shift = R::splat(6_755_399_441_055_744.0);
+    crate::lanes::pick(v.simd_abs().simd_lt(R::splat(2_251_799_813_685_248.0)), (v + shift) - shift, v)
 }
 
 #[cfg(test)]
@@ -60,11 +64,14 @@ mod tests {
 
     #[test]
     fn nearest_integer_matches_round_away_from_ties() {
-        for &v in &[0.0, 0.49, 0.51, -0.49, -0.51, 1.2, -1.7, 3.0, -3.0, 1e10 + 0.3, -1e10 - 0.7, 1e300, -1e300, 4503599627370497.0] {
+        use simba::simd::SimdValue;
+        for &v in &[0.0f64, 0.49, 0.51, -0.49, -0.51, 1.2, -1.7, 3.0, -3.0, 1e10 + 0.3, -1e10 - 0.7, 1e300, -1e300, 4503599627370497.0] {
             assert_eq!(nearest_integer(v), v.round(), "{v}");
+            let lanes: crate::lanes::Lanes = nearest_integer(crate::lanes::Lanes::splat(v));
+            assert_eq!(lanes.extract(2), v.round(), "{v} in lanes");
         }
-        assert_eq!(nearest_integer(2.5), 2.0);
-        assert_eq!(nearest_integer(-0.5).abs(), 0.0);
+        assert_eq!(nearest_integer(2.5f64), 2.0);
+        assert_eq!(nearest_integer(-0.5f64).abs(), 0.0);
     }
 
     #[test]

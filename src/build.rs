@@ -354,7 +354,7 @@ impl Parts<'_> {
             law,
             pair_table: PairTable::new(&scene.materials),
             wall_material: self.wall_material,
-            pairs: PairList::default(),
+            pairs: PairList { keep_energy: E, ..Default::default() },
             walls: self.walls,
             wall_hist,
             wall_active,

@@ -107,6 +107,11 @@ pub struct PairMaterial<R = f64> {
     pub beta: R,
     /// Friction coefficient of the pair (the smaller one).
     pub friction: R,
+    /// `-2 sqrt(5/6) beta sqrt(2 E*)`, Pa^1/2: the viscoelastic normal damping is
+    /// `gn = viscous_n sqrt(m*) (R* dn)^(1/4)` ([`crate::contact::damping`]).
+    pub viscous_n: R,
+    /// `-2 sqrt(5/6) beta sqrt(8 G*)`, Pa^1/2: `gt = viscous_t sqrt(m*) (R* dn)^(1/4)`.
+    pub viscous_t: R,
 }
 
 impl PairMaterial<crate::lanes::Lanes> {
@@ -120,6 +125,8 @@ impl PairMaterial<crate::lanes::Lanes> {
             restitution: gather(|l| pm[l].restitution),
             beta: gather(|l| pm[l].beta),
             friction: gather(|l| pm[l].friction),
+            viscous_n: gather(|l| pm[l].viscous_n),
+            viscous_t: gather(|l| pm[l].viscous_t),
         }
     }
 }
@@ -130,7 +137,10 @@ impl PairMaterial {
         let e_star = 1.0 / ((1.0 - n1 * n1) / e1 + (1.0 - n2 * n2) / e2);
         let g_star = 1.0 / (2.0 * (2.0 - n1) * (1.0 + n1) / e1 + 2.0 * (2.0 - n2) * (1.0 + n2) / e2);
         let restitution = a.restitution.min(b.restitution);
-        PairMaterial { e_star, g_star, restitution, beta: beta(restitution), friction: a.friction.min(b.friction) }
+        let beta = beta(restitution);
+        let c = -2.0 * crate::contact::damping::SQRT_FIVE_SIXTHS * beta;
+        let (viscous_n, viscous_t) = (c * (2.0 * e_star).sqrt(), c * (8.0 * g_star).sqrt());
+        PairMaterial { e_star, g_star, restitution, beta, friction: a.friction.min(b.friction), viscous_n, viscous_t }
     }
 }
 

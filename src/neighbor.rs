@@ -8,7 +8,7 @@
 //! new one with one merge.
 
 use crate::boundary::Boundary;
-use crate::contact::ContactHistory;
+use crate::contact::EnergyMemory;
 use crate::dim::Vec2;
 use crate::threads::Threads;
 
@@ -19,10 +19,18 @@ pub struct PairList<H> {
     pub pairs: Vec<[u32; 2]>,
     /// What each pair's kernel would otherwise divide out at every step, parallel to `pairs`.
     pub consts: Vec<PairConst>,
-    /// History of each pair, parallel to `pairs`.
-    pub hist: Vec<ContactHistory<H>>,
+    /// `(r_i + r_j)^2` of each pair, m^2, parallel to `pairs`: the pair touches when its
+    /// distance squared is below (the contact sweep reads only this, the positions and
+    /// `active`).
+    pub reach: Vec<f64>,
+    /// Tangential state of each pair, parallel to `pairs`.
+    pub hist: Vec<H>,
+    /// Energy memory of each pair, parallel to `pairs` when `keep_energy`, else empty.
+    pub energy: Vec<EnergyMemory>,
     /// True while the pair is (or was at the previous step) touching, parallel to `pairs`.
     pub active: Vec<bool>,
+    /// Keep the energy memory (the run has the energy ledger on).
+    pub keep_energy: bool,
 }
 
 /// The constants of a listed pair, computed once per neighbour-list build.
@@ -30,8 +38,8 @@ pub struct PairList<H> {
 pub struct PairConst {
     /// Reduced radius R* = r_i r_j / (r_i + r_j), m.
     pub r_star: f64,
-    /// Reduced mass m* = m_i m_j / (m_i + m_j), kg.
-    pub m_star: f64,
+    /// Square root of the reduced mass m* = m_i m_j / (m_i + m_j), kg^1/2.
+    pub sqrt_m_star: f64,
     /// 1 / min(r_i, r_j), 1/m (overlap ratio for the watchdog).
     pub inv_r_min: f64,
 }
@@ -43,23 +51,34 @@ impl<H: Copy + Default> PairList<H> {
         self.consts.clear();
         self.consts.extend(new_pairs.iter().map(|&[i, j]| {
             let (i, j) = (i as usize, j as usize);
-            PairConst { r_star: crate::material::reduced(r[i], r[j]), m_star: crate::material::reduced(m[i], m[j]), inv_r_min: 1.0 / r[i].min(r[j]) }
+            PairConst { r_star: crate::material::reduced(r[i], r[j]), sqrt_m_star: crate::material::reduced(m[i], m[j]).sqrt(), inv_r_min: 1.0 / r[i].min(r[j]) }
         }));
-        let mut hist = vec![ContactHistory::default(); new_pairs.len()];
-        let mut active = vec![false; new_pairs.len()];
+        self.reach.clear();
+        self.reach.extend(new_pairs.iter().map(|&[i, j]| {
+            let radsum = r[i as usize] + r[j as usize];
+            radsum * radsum
+        }));
+        let np = new_pairs.len();
+        let mut hist = vec![H::default(); np];
+        let mut active = vec![false; np];
+        let mut energy = vec![EnergyMemory::default(); if self.keep_energy { np } else { 0 }];
         let mut k = 0;
-        for ((slot, on), p) in hist.iter_mut().zip(active.iter_mut()).zip(&new_pairs) {
+        for (m, p) in new_pairs.iter().enumerate() {
             while k < self.pairs.len() && self.pairs[k] < *p {
                 k += 1;
             }
             if k < self.pairs.len() && self.pairs[k] == *p {
-                *slot = self.hist[k];
-                *on = self.active[k];
+                hist[m] = self.hist[k];
+                active[m] = self.active[k];
+                if self.keep_energy {
+                    energy[m] = self.energy[k];
+                }
             }
         }
         self.pairs = new_pairs;
         self.hist = hist;
         self.active = active;
+        self.energy = energy;
     }
     /// Number of pairs currently touching (active history).
     pub fn touching(&self) -> usize {
@@ -275,19 +294,22 @@ mod tests {
 
     #[test]
     fn history_survives_a_rebuild_and_leaves_with_its_pair() {
-        let mut list: PairList<f64> = PairList::default();
+        let mut list: PairList<f64> = PairList { keep_energy: true, ..Default::default() };
         let (r, m) = (vec![1.0; 5], vec![1.0; 5]);
         list.replace(vec![[0, 1], [0, 2], [3, 4]], &r, &m);
         for (k, h) in list.hist.iter_mut().enumerate() {
-            h.tangential = k as f64 + 1.0;
+            *h = k as f64 + 1.0;
+            list.energy[k].ut_prev = 10.0 * (k as f64 + 1.0);
             list.active[k] = true;
         }
         // [0, 2] leaves, [1, 2] and [2, 3] arrive, the others stay.
         list.replace(vec![[0, 1], [1, 2], [2, 3], [3, 4]], &r, &m);
         assert_eq!(list.consts.len(), 4);
         assert_eq!(list.consts[1].r_star, 0.5);
-        let kept: Vec<f64> = list.hist.iter().map(|h| h.tangential).collect();
+        let kept: Vec<f64> = list.hist.clone();
         assert_eq!(kept, vec![1.0, 0.0, 0.0, 3.0]);
+        let kept: Vec<f64> = list.energy.iter().map(|e| e.ut_prev).collect();
+        assert_eq!(kept, vec![10.0, 0.0, 0.0, 30.0]);
         assert_eq!(list.touching(), 2);
     }
 }

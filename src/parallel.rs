@@ -18,6 +18,7 @@ use crate::contact::ContactModel;
 use crate::contact::damping::Damping;
 use crate::contact::tangential::Tangential;
 use crate::error::Error;
+use crate::contact::EnergyMemory;
 use crate::observe::energy::EnergyLedger;
 use crate::pipeline::{Ledgers, PairOut, PairSlices, PairView, Pending, Stage, compute_pairs, pair_contact, sort_pairs};
 use crate::sim::World;
@@ -150,19 +151,23 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
         let mut f = std::mem::take(&mut w.p.f);
         let mut torque = std::mem::take(&mut w.p.torque);
         let view = PairView { p: &w.p, boundary: w.boundary, law: w.law, pair_table: &w.pair_table, dt: w.dt };
-        let (pairs, consts) = (&w.pairs.pairs, &w.pairs.consts);
+        let (pairs, consts, reach) = (&w.pairs.pairs, &w.pairs.consts, &w.pairs.reach);
         let (bounds, pb, cb) = (&self.bounds, &self.pair_bounds, &self.cross_bounds);
         let (cross, cross_slot, incoming) = (&self.cross, &self.cross_slot, &self.incoming);
         let threads = &self.threads;
         {
             // (1) Each range's cross pairs, into their slots.
-            let parts = cut(&mut w.pairs.hist, pb).into_iter().zip(cut(&mut w.pairs.active, pb)).zip(cut(&mut self.ledgers, &ledger_bounds)).zip(cut(&mut self.cross_out, cb));
-            threads.each(parts.collect(), |r, (((hist, active), ledgers), out)| {
-                let mut none = EnergyLedger::default();
+            let parts = cut(&mut w.pairs.hist, pb)
+                .into_iter()
+                .zip(cut(&mut w.pairs.active, pb))
+                .zip(cut(&mut self.ledgers, &ledger_bounds).into_iter().zip(cut(&mut w.pairs.energy, &ledger_bounds)))
+                .zip(cut(&mut self.cross_out, cb));
+            threads.each(parts.collect(), |r, (((hist, active), (ledgers, energy)), out)| {
+                let (mut none, mut no_memory) = (EnergyLedger::default(), EnergyMemory::default());
                 for (s, o) in (cb[r]..cb[r + 1]).zip(out.iter_mut()) {
                     let k = cross[s] as usize;
-                    let l = if ENERGY { &mut ledgers[k - pb[r]] } else { &mut none };
-                    *o = pair_contact::<Dm, T, ENERGY>(&view, pairs[k], &consts[k], &mut hist[k - pb[r]], &mut active[k - pb[r]], l);
+                    let (l, e) = if ENERGY { (&mut ledgers[k - pb[r]], &mut energy[k - pb[r]]) } else { (&mut none, &mut no_memory) };
+                    *o = pair_contact::<Dm, T, ENERGY>(&view, pairs[k], &consts[k], &mut hist[k - pb[r]], e, &mut active[k - pb[r]], l);
                 }
             });
             let cross_out = &self.cross_out;
@@ -170,11 +175,11 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
             let parts = cut(&mut w.pairs.hist, pb)
                 .into_iter()
                 .zip(cut(&mut w.pairs.active, pb))
-                .zip(cut(&mut self.ledgers, &ledger_bounds))
+                .zip(cut(&mut self.ledgers, &ledger_bounds).into_iter().zip(cut(&mut w.pairs.energy, &ledger_bounds)))
                 .zip(cut(&mut f, bounds))
                 .zip(cut(&mut torque, bounds))
                 .zip(self.scratch.iter_mut());
-            threads.each(parts.collect(), |r, (((((hist, active), ledgers), fl), tl), sc)| {
+            threads.each(parts.collect(), |r, (((((hist, active), (ledgers, energy)), fl), tl), sc)| {
                 let (g0, part) = (bounds[r], pb[r]..pb[r + 1]);
                 for &s in &incoming[r] {
                     let o = &cross_out[s as usize];
@@ -186,11 +191,20 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
                         }
                     }
                 }
-                let (nt, nr) = sort_pairs(view.p, &view.boundary, &pairs[part.clone()], active, Some(&cross_slot[part.clone()]), &mut sc.touching, &mut sc.released);
+                let (nt, nr) = sort_pairs(&view.p.x, &view.boundary, &pairs[part.clone()], &reach[part.clone()], active, Some(&cross_slot[part.clone()]), &mut sc.touching, &mut sc.released);
                 let mut none = EnergyLedger::default();
                 let l = if ENERGY { Ledgers::PerPair(ledgers) } else { Ledgers::One(&mut none) };
-                let list = PairSlices::<T> { pairs: &pairs[part.clone()], consts: &consts[part.clone()], hist, active };
-                compute_pairs::<Dm, T, ENERGY>(&view, list, &sc.touching[..nt], &sc.released[..nr], l, &mut sc.out, &mut sc.pending);
+                let list = PairSlices::<T> { pairs: &pairs[part.clone()], consts: &consts[part.clone()], hist, energy, active };
+                if sc.out.len() < nt {
+                    sc.out.resize(nt, PairOut::default());
+                }
+                let mut m = 0;
+                let out = &mut sc.out;
+                let sink = |_, o: PairOut| {
+                    out[m] = o;
+                    m += 1;
+                };
+                compute_pairs::<Dm, T, ENERGY>(&view, list, &sc.touching[..nt], &sc.released[..nr], l, sink, &mut sc.pending);
                 let mut best = (0.0, usize::MAX);
                 let mut add = |k: usize, o: &PairOut, own: bool| {
                     let (i, j) = (pairs[k][0] as usize - g0, pairs[k][1] as usize);

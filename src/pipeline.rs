@@ -6,12 +6,12 @@
 //! periodicity.)
 
 use nalgebra::Vector2;
-use simba::simd::SimdValue;
+use simba::simd::{SimdBool, SimdPartialOrd, SimdValue};
 
 use crate::boundary::Boundary;
 use crate::contact::damping::Damping;
 use crate::contact::tangential::Tangential;
-use crate::contact::{ContactHistory, ContactInput, ContactLaw, ContactModel, LeverArm};
+use crate::contact::{ContactInput, ContactLaw, ContactModel, EnergyMemory, LeverArm};
 use crate::dim::{Vec2, cross};
 use crate::lanes::{LANES, Lanes, Real, gather, gather2, lane2};
 use crate::material::PairMaterial;
@@ -186,14 +186,14 @@ pub struct PairOut {
 /// `d` (minimum image, i minus j), radii, spins, relative velocity and constants.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-fn pair_input<R: Real, T: Tangential>(lever: LeverArm, d: Vector2<R>, ri: R, rj: R, wi: R, wj: R, v_rel: Vector2<R>, r_star: R, m_star: R, dt: R) -> ContactInput<R> {
+fn pair_input<R: Real, T: Tangential>(lever: LeverArm, d: Vector2<R>, ri: R, rj: R, wi: R, wj: R, v_rel: Vector2<R>, r_star: R, sqrt_m_star: R, dt: R) -> ContactInput<R> {
     let radsum = ri + rj;
     let r = d.norm_squared().simd_sqrt();
-    let n = d / r;
+    let n = d * r.simd_recip();
     let dn = radsum - r;
     let spin = if T::FRICTION { lever.arm(ri, dn) * wi + lever.arm(rj, dn) * wj } else { R::zero() };
     let tangential_scale = if T::FRICTION { lever.translation_scale(radsum, dn) } else { R::one() };
-    ContactInput { n, dn, r_star, m_star, v_rel, spin, dt, tangential_scale }
+    ContactInput { n, dn, r_star, sqrt_m_star, v_rel, spin, dt, tangential_scale }
 }
 
 /// The torques `-a n x Ft` to subtract from grains i and j.
@@ -204,13 +204,16 @@ fn pair_torque<R: Real>(lever: LeverArm, c: &ContactInput<R>, ft: Vector2<R>, ri
 }
 
 /// One pair of the Verlet list: the contact force (touching), the end of a contact
-/// (released), or nothing; history and energy terms updated.
+/// (released), or nothing; tangential state `h`, energy memory `e` (with `ENERGY`) and
+/// energy terms updated.
 #[inline(always)]
+#[allow(clippy::too_many_arguments)]
 pub fn pair_contact<Dm: Damping, T: Tangential, const ENERGY: bool>(
     w: &PairView<'_, ContactModel<Dm, T>>,
     pair: [u32; 2],
     pc: &PairConst,
-    h: &mut crate::sim::Hist<ContactModel<Dm, T>>,
+    h: &mut T::History<f64>,
+    e: &mut EnergyMemory,
     active: &mut bool,
     ledger: &mut EnergyLedger,
 ) -> PairOut {
@@ -226,54 +229,61 @@ pub fn pair_contact<Dm: Damping, T: Tangential, const ENERGY: bool>(
             let n = d / rsq.sqrt();
             let spin = if T::FRICTION { ri * p.omega[i] + rj * p.omega[j] } else { 0.0 };
             let vc = p.v[i] - p.v[j] + spin * Vec2::new(n.y, -n.x);
-            model.release::<ENERGY>(vc, n, w.dt, h, ledger);
+            model.release::<ENERGY>(vc, n, w.dt, h, e, ledger);
             *active = false;
         }
         return PairOut::default();
     }
-    let (o, pend) = one_pair(w, (i, j), d, pc, &mut h.tangential, active);
+    let (o, pend) = one_pair(w, (i, j), d, pc, h, active);
     if ENERGY {
-        model.account(pend.n, pend.dn, w.dt, &pend.state, h, ledger);
+        model.account(pend.n, pend.dn, w.dt, &pend.state, e, ledger);
     }
     o
 }
 
 /// Four touching pairs at once, one per SIMD lane (`ks`: their indices in the list):
-/// the same bits as [`one_pair`] gives each of them; with `ENERGY`, what their
-/// accounting needs goes to `pending`.
+/// the same bits as [`one_pair`] gives each of them, handed to `sink` (list index and
+/// output) in lane order; with `ENERGY`, what their accounting needs goes to `pending`.
 #[inline(always)]
 fn four_pairs<Dm: Damping, T: Tangential, const ENERGY: bool>(
     w: &PairView<'_, ContactModel<Dm, T>>,
     list: PairSlices<'_, T>,
     single: Option<&PairMaterial<Lanes>>,
     ks: &[u32],
-    out: &mut [PairOut],
+    sink: &mut impl FnMut((usize, usize), PairOut),
     pending: &mut [Pending],
 ) {
     let (model, p) = (w.law, w.p);
     let lever = model.options.lever_arm;
+    // The per-pair and per-grain slices cut to one length each, so that one bounds check
+    // per index serves every array it reads.
+    let np = list.pairs.len();
+    let (pairs, consts, hist, active) = (&list.pairs[..np], &list.consts[..np], &mut list.hist[..np], &mut list.active[..np]);
+    let n = p.x.len();
+    let (x, v, r, omega) = (&p.x[..n], &p.v[..n], &p.r[..n], &p.omega[..n]);
+    let ks: [usize; LANES] = std::array::from_fn(|l| ks[l] as usize);
     let ij: [(usize, usize); LANES] = std::array::from_fn(|l| {
-        let q = list.pairs[ks[l] as usize];
+        let q = pairs[ks[l]];
         (q[0] as usize, q[1] as usize)
     });
-    let pc: [&PairConst; LANES] = std::array::from_fn(|l| &list.consts[ks[l] as usize]);
-    let d = gather2(|l| w.boundary.image(p.x[ij[l].0] - p.x[ij[l].1]));
-    let (ri, rj) = (gather(|l| p.r[ij[l].0]), gather(|l| p.r[ij[l].1]));
-    let (wi, wj) = if T::FRICTION { (gather(|l| p.omega[ij[l].0]), gather(|l| p.omega[ij[l].1])) } else { (Lanes::splat(0.0), Lanes::splat(0.0)) };
-    let v_rel = gather2(|l| p.v[ij[l].0] - p.v[ij[l].1]);
-    let input = pair_input::<Lanes, T>(lever, d, ri, rj, wi, wj, v_rel, gather(|l| pc[l].r_star), gather(|l| pc[l].m_star), Lanes::splat(w.dt));
+    let pc: [&PairConst; LANES] = std::array::from_fn(|l| &consts[ks[l]]);
+    let d = gather2(|l| w.boundary.image(x[ij[l].0] - x[ij[l].1]));
+    let (ri, rj) = (gather(|l| r[ij[l].0]), gather(|l| r[ij[l].1]));
+    let (wi, wj) = if T::FRICTION { (gather(|l| omega[ij[l].0]), gather(|l| omega[ij[l].1])) } else { (Lanes::splat(0.0), Lanes::splat(0.0)) };
+    let v_rel = gather2(|l| v[ij[l].0] - v[ij[l].1]);
+    let input = pair_input::<Lanes, T>(lever, d, ri, rj, wi, wj, v_rel, gather(|l| pc[l].r_star), gather(|l| pc[l].sqrt_m_star), Lanes::splat(w.dt));
     let pm = match single {
         Some(pm) => *pm,
         None => PairMaterial::gather(std::array::from_fn(|l| w.pair_table.get(p.material[ij[l].0] as usize, p.material[ij[l].1] as usize))),
     };
-    let mut h = T::gather(std::array::from_fn(|l| &list.hist[ks[l] as usize].tangential));
+    let mut h = T::gather(std::array::from_fn(|l| &hist[ks[l]]));
     let c = model.force(&input, &pm, &mut h);
     let torque = if T::FRICTION { pair_torque(lever, &input, c.tangential.elastic + c.tangential.damping, ri, rj) } else { [Lanes::splat(0.0); 2] };
     let ratio = input.dn * gather(|l| pc[l].inv_r_min);
     for l in 0..LANES {
-        list.hist[ks[l] as usize].tangential = T::lane(&h, l);
-        list.active[ks[l] as usize] = true;
-        out[l] = PairOut { force: lane2(&c.force, l), torque: [torque[0].extract(l), torque[1].extract(l)], ratio: ratio.extract(l) };
+        hist[ks[l]] = T::lane(&h, l);
+        active[ks[l]] = true;
+        sink(ij[l], PairOut { force: lane2(&c.force, l), torque: [torque[0].extract(l), torque[1].extract(l)], ratio: ratio.extract(l) });
         if ENERGY {
             pending[l] = Pending { n: lane2(&input.n, l), dn: input.dn.extract(l), state: c.lane(l) };
         }
@@ -293,7 +303,7 @@ fn one_pair<Dm: Damping, T: Tangential>(
 ) -> (PairOut, Pending) {
     let (model, p) = (w.law, w.p);
     let lever = model.options.lever_arm;
-    let input = pair_input::<f64, T>(lever, d, p.r[i], p.r[j], p.omega[i], p.omega[j], p.v[i] - p.v[j], pc.r_star, pc.m_star, w.dt);
+    let input = pair_input::<f64, T>(lever, d, p.r[i], p.r[j], p.omega[i], p.omega[j], p.v[i] - p.v[j], pc.r_star, pc.sqrt_m_star, w.dt);
     let pm = w.pair_table.get(p.material[i] as usize, p.material[j] as usize);
     let c = model.force(&input, pm, h);
     *active = true;
@@ -310,11 +320,13 @@ pub struct Pending {
     state: crate::contact::model::ContactState,
 }
 
-/// A part of the pair list: the pairs, their constants, histories and touching flags.
+/// A part of the pair list: the pairs, their constants, tangential states, energy
+/// memories (empty without the energy ledger) and touching flags.
 pub struct PairSlices<'a, T: Tangential> {
     pub pairs: &'a [[u32; 2]],
     pub consts: &'a [PairConst],
-    pub hist: &'a mut [ContactHistory<T::History<f64>>],
+    pub hist: &'a mut [T::History<f64>],
+    pub energy: &'a mut [EnergyMemory],
     pub active: &'a mut [bool],
 }
 
@@ -337,33 +349,56 @@ impl Ledgers<'_> {
 
 /// The pairs of a list part that are touching, and those that were at the previous step
 /// and are not any more, as indices into the part, in list order: the first `nt` of
-/// `touching` and the first `nr` of `released`, `(nt, nr)` returned. `skip` (if given)
+/// `touching` and the first `nr` of `released`, `(nt, nr)` returned. `reach` holds each
+/// pair's `(r_i + r_j)^2` ([`crate::neighbor::PairList::reach`]). `skip` (if given)
 /// leaves out pairs computed elsewhere. No branch per pair, and the lists keep their
 /// length from step to step (no clearing).
-pub fn sort_pairs(p: &Particles, boundary: &Boundary, pairs: &[[u32; 2]], active: &[bool], skip: Option<&[u32]>, touching: &mut Vec<u32>, released: &mut Vec<u32>) -> (usize, usize) {
+#[allow(clippy::too_many_arguments)]
+pub fn sort_pairs(x: &[Vec2], boundary: &Boundary, pairs: &[[u32; 2]], reach: &[f64], active: &[bool], skip: Option<&[u32]>, touching: &mut Vec<u32>, released: &mut Vec<u32>) -> (usize, usize) {
     if touching.len() < pairs.len() {
         touching.resize(pairs.len(), 0);
         released.resize(pairs.len(), 0);
     }
+    match skip {
+        None => sweep(x, boundary, pairs, reach, active, |_| true, touching, released),
+        Some(s) => sweep(x, boundary, pairs, reach, active, |k| s[k] == u32::MAX, touching, released),
+    }
+}
+
+/// The sweep of [`sort_pairs`]: four pairs' distances at a time in lanes, then their
+/// indices appended where they belong.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn sweep(x: &[Vec2], boundary: &Boundary, pairs: &[[u32; 2]], reach: &[f64], active: &[bool], mine: impl Fn(usize) -> bool, touching: &mut [u32], released: &mut [u32]) -> (usize, usize) {
+    // Cut to one length each: one bounds check per index.
+    let (np, n) = (pairs.len(), x.len());
+    let (reach, active, touching, released, x) = (&reach[..np], &active[..np], &mut touching[..np], &mut released[..np], &x[..n]);
     let (mut nt, mut nr) = (0, 0);
-    for (k, (pair, &was)) in pairs.iter().zip(active).enumerate() {
-        let (i, j) = (pair[0] as usize, pair[1] as usize);
-        let d = boundary.image(p.x[i] - p.x[j]);
-        let radsum = p.r[i] + p.r[j];
-        let mine = skip.is_none_or(|s| s[k] == u32::MAX);
-        let touch = d.norm_squared() < radsum * radsum;
+    let mut put = |k: usize, touch: bool| {
+        let mine = mine(k);
         touching[nt] = k as u32;
         released[nr] = k as u32;
         nt += (touch & mine) as usize;
-        nr += (!touch & was & mine) as usize;
+        nr += (!touch & active[k] & mine) as usize;
+    };
+    let quads = pairs.len() / LANES * LANES;
+    for (q, (pq, rq)) in pairs[..quads].chunks_exact(LANES).zip(reach.chunks_exact(LANES)).enumerate() {
+        let d: Vector2<Lanes> = boundary.image(gather2(|l| x[pq[l][0] as usize] - x[pq[l][1] as usize]));
+        let touch = d.norm_squared().simd_lt(gather(|l| rq[l])).bitmask();
+        for l in 0..LANES {
+            put(q * LANES + l, touch >> l & 1 != 0);
+        }
+    }
+    for k in quads..pairs.len() {
+        let d = boundary.image(x[pairs[k][0] as usize] - x[pairs[k][1] as usize]);
+        put(k, d.norm_squared() < reach[k]);
     }
     (nt, nr)
 }
 
 /// Compute the pairs `touching` and `released` of a list part (indices from
-/// [`sort_pairs`]): the output of `touching[m]` goes to `out[m]` (`out` keeps its
-/// length from step to step; it grows when needed). The touching pairs run four at a
-/// time in SIMD lanes. With the energy ledger, their accounting (and the released pairs')
+/// [`sort_pairs`]): the output of each touching pair goes to `sink` (its list index and
+/// output), in list order. The touching pairs run four at a time in SIMD lanes. With the energy ledger, their accounting (and the released pairs')
 /// then follows in list order, so that the ledger sums in the serial order; `pending`
 /// holds what it needs meanwhile.
 #[allow(clippy::too_many_arguments)]
@@ -373,30 +408,27 @@ pub fn compute_pairs<Dm: Damping, T: Tangential, const ENERGY: bool>(
     touching: &[u32],
     released: &[u32],
     mut ledgers: Ledgers<'_>,
-    out: &mut Vec<PairOut>,
+    mut sink: impl FnMut((usize, usize), PairOut),
     pending: &mut Vec<Pending>,
 ) {
-    if out.len() < touching.len() {
-        out.resize(touching.len(), PairOut::default());
-    }
     if ENERGY && pending.len() < touching.len() {
         pending.resize(touching.len(), Pending::default());
     }
     let quads = touching.len() / LANES * LANES;
     // One material: its lanes once, not a table lookup per lane.
     let single = w.pair_table.single().map(|m| PairMaterial::gather([m; LANES]));
-    let PairSlices { pairs, consts, hist, active } = list;
+    let PairSlices { pairs, consts, hist, energy, active } = list;
     let mut pend = pending.chunks_exact_mut(LANES);
-    for (ks, o) in touching[..quads].chunks_exact(LANES).zip(out.chunks_exact_mut(LANES)) {
-        let slices = PairSlices::<T> { pairs, consts, hist: &mut *hist, active: &mut *active };
-        four_pairs::<Dm, T, ENERGY>(w, slices, single.as_ref(), ks, o, if ENERGY { pend.next().expect("a slot per pair") } else { &mut [] });
+    for ks in touching[..quads].chunks_exact(LANES) {
+        let slices = PairSlices::<T> { pairs, consts, hist: &mut *hist, energy: &mut [], active: &mut *active };
+        four_pairs::<Dm, T, ENERGY>(w, slices, single.as_ref(), ks, &mut sink, if ENERGY { pend.next().expect("a slot per pair") } else { &mut [] });
     }
     for (m, &k) in touching.iter().enumerate().skip(quads) {
         let k = k as usize;
         let (i, j) = (pairs[k][0] as usize, pairs[k][1] as usize);
         let d = w.boundary.image(w.p.x[i] - w.p.x[j]);
-        let (o, p) = one_pair(w, (i, j), d, &consts[k], &mut hist[k].tangential, &mut active[k]);
-        out[m] = o;
+        let (o, p) = one_pair(w, (i, j), d, &consts[k], &mut hist[k], &mut active[k]);
+        sink((i, j), o);
         if ENERGY {
             pending[m] = p;
         }
@@ -405,7 +437,7 @@ pub fn compute_pairs<Dm: Damping, T: Tangential, const ENERGY: bool>(
     if !ENERGY {
         for &k in released {
             let k = k as usize;
-            pair_contact::<Dm, T, false>(w, pairs[k], &consts[k], &mut hist[k], &mut active[k], &mut none);
+            pair_contact::<Dm, T, false>(w, pairs[k], &consts[k], &mut hist[k], &mut EnergyMemory::default(), &mut active[k], &mut none);
         }
         return;
     }
@@ -414,11 +446,11 @@ pub fn compute_pairs<Dm: Damping, T: Tangential, const ENERGY: bool>(
     while a < touching.len() || b < released.len() {
         if b == released.len() || (a < touching.len() && touching[a] < released[b]) {
             let (k, p) = (touching[a] as usize, &pending[a]);
-            w.law.account(p.n, p.dn, w.dt, &p.state, &mut hist[k], ledgers.get(k));
+            w.law.account(p.n, p.dn, w.dt, &p.state, &mut energy[k], ledgers.get(k));
             a += 1;
         } else {
             let k = released[b] as usize;
-            pair_contact::<Dm, T, true>(w, pairs[k], &consts[k], &mut hist[k], &mut active[k], ledgers.get(k));
+            pair_contact::<Dm, T, true>(w, pairs[k], &consts[k], &mut hist[k], &mut energy[k], &mut active[k], ledgers.get(k));
             b += 1;
         }
     }
@@ -441,7 +473,6 @@ pub struct PairView<'a, L: ContactLaw> {
 pub struct PairForces<const ENERGY: bool> {
     touching: Vec<u32>,
     released: Vec<u32>,
-    out: Vec<PairOut>,
     pending: Vec<Pending>,
 }
 
@@ -454,14 +485,15 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
         let mut f = std::mem::take(&mut w.p.f);
         let mut torque = std::mem::take(&mut w.p.torque);
         let (pairs, consts) = (&w.pairs.pairs, &w.pairs.consts);
-        let (nt, nr) = sort_pairs(&w.p, &w.boundary, pairs, &w.pairs.active, None, &mut self.touching, &mut self.released);
+        let (nt, nr) = sort_pairs(&w.p.x, &w.boundary, pairs, &w.pairs.reach, &w.pairs.active, None, &mut self.touching, &mut self.released);
         let (touching, released) = (&self.touching[..nt], &self.released[..nr]);
         let view = PairView { p: &w.p, boundary: w.boundary, law: w.law, pair_table: &w.pair_table, dt: w.dt };
-        let list = PairSlices::<T> { pairs, consts, hist: &mut w.pairs.hist, active: &mut w.pairs.active };
-        compute_pairs::<Dm, T, ENERGY>(&view, list, touching, released, Ledgers::One(&mut w.ledger), &mut self.out, &mut self.pending);
-        for (&k, o) in touching.iter().zip(&self.out) {
-            let pair = pairs[k as usize];
-            let (i, j) = (pair[0] as usize, pair[1] as usize);
+        let list = PairSlices::<T> { pairs, consts, hist: &mut w.pairs.hist, energy: &mut w.pairs.energy, active: &mut w.pairs.active };
+        // Each pair's force goes to its grains as it comes, in list order.
+        let n = f.len();
+        let (fs, ts) = (&mut f[..n], &mut torque[..n]);
+        let sink = |(i, j): (usize, usize), o: PairOut| {
+            let (f, torque) = (&mut *fs, &mut *ts);
             f[i] += o.force;
             f[j] -= o.force;
             if T::FRICTION {
@@ -471,7 +503,8 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
             if o.ratio > worst.0 {
                 worst = (o.ratio, i, j);
             }
-        }
+        };
+        compute_pairs::<Dm, T, ENERGY>(&view, list, touching, released, Ledgers::One(&mut w.ledger), sink, &mut self.pending);
         w.p.f = f;
         w.p.torque = torque;
         w.max_overlap = worst;
@@ -507,7 +540,7 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
                     if active[i] {
                         let spin = if T::FRICTION { ri * p.omega[i] } else { 0.0 };
                         let vc = p.v[i] - wall.v + spin * Vec2::new(n.y, -n.x);
-                        model.release::<ENERGY>(vc, n, dt, h, &mut w.ledger);
+                        model.release::<ENERGY>(vc, n, dt, &mut h.tangential, &mut h.energy, &mut w.ledger);
                         active[i] = false;
                     }
                     continue;
@@ -515,7 +548,7 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
                 let dn = ri - gap;
                 let ai = if T::FRICTION { lever.arm(ri, dn) } else { 0.0 };
                 let spin = if T::FRICTION { ai * p.omega[i] } else { 0.0 };
-                let input = ContactInput { n, dn, r_star: ri, m_star: p.m[i], v_rel: p.v[i] - wall.v, spin, dt, tangential_scale: 1.0 };
+                let input = ContactInput { n, dn, r_star: ri, sqrt_m_star: p.m[i].sqrt(), v_rel: p.v[i] - wall.v, spin, dt, tangential_scale: 1.0 };
                 let pm = w.pair_table.get(p.material[i] as usize, w.wall_material);
                 let c = model.touch::<ENERGY>(&input, pm, h, &mut w.ledger);
                 active[i] = true;

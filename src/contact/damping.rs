@@ -5,14 +5,22 @@
 //! and YADE `betan = betas = sqrt(5/6) |beta|`). The damping force is `-g v` along the
 //! relative velocity. [`Undamped`] is what a scene with e = 1 everywhere gets: no
 //! coefficients are computed at all.
+//!
+//! With `Sn = 2 E* sqrt(R* dn)` and `St = 8 G* sqrt(R* dn)` the coefficients factor as
+//! `gn = cn sqrt(m*) (R* dn)^(1/4)` with `cn = -2 sqrt(5/6) beta sqrt(2 E*)` per material
+//! pair ([`crate::material::PairMaterial::viscous_n`]) and `sqrt(m*)` per grain pair
+//! (computed once per neighbour-list build): one square root per contact and step instead
+//! of two.
 
-use crate::lanes::{Real, k};
+use crate::lanes::Real;
+use crate::material::PairMaterial;
 
 /// How the damping coefficients follow from the stiffnesses.
 pub trait Damping: Copy + Default + Send + Sync + 'static {
     const NAME: &'static str;
-    /// `(gn, gt)`, kg/s, from `beta`, the tangent stiffnesses `Sn`, `St` (N/m) and `m*` (kg).
-    fn coefficients<R: Real>(beta: R, sn: R, st: R, m_star: R) -> (R, R);
+    /// `(gn, gt)`, kg/s, from the pair's materials, `sqrt(m*)` (kg^1/2) and
+    /// `sqrt(R* dn)` (m).
+    fn coefficients<R: Real>(pm: &PairMaterial<R>, sqrt_m_star: R, root: R) -> (R, R);
 }
 
 /// sqrt(5/6).
@@ -24,9 +32,9 @@ pub struct Viscoelastic;
 impl Damping for Viscoelastic {
     const NAME: &'static str = "Viscoelastic";
     #[inline(always)]
-    fn coefficients<R: Real>(beta: R, sn: R, st: R, m_star: R) -> (R, R) {
-        let c = k::<R>(-2.0 * SQRT_FIVE_SIXTHS) * beta;
-        (c * (sn * m_star).simd_sqrt(), c * (st * m_star).simd_sqrt())
+    fn coefficients<R: Real>(pm: &PairMaterial<R>, sqrt_m_star: R, root: R) -> (R, R) {
+        let s = sqrt_m_star * root.simd_sqrt();
+        (pm.viscous_n * s, pm.viscous_t * s)
     }
 }
 
@@ -36,7 +44,7 @@ pub struct Undamped;
 impl Damping for Undamped {
     const NAME: &'static str = "Undamped";
     #[inline(always)]
-    fn coefficients<R: Real>(_: R, _: R, _: R, _: R) -> (R, R) {
+    fn coefficients<R: Real>(_: &PairMaterial<R>, _: R, _: R) -> (R, R) {
         (R::zero(), R::zero())
     }
 }

@@ -87,8 +87,8 @@ pub struct ContactInput<R: Real = f64> {
     pub dn: R,
     /// Reduced radius R*, m.
     pub r_star: R,
-    /// Reduced mass m*, kg.
-    pub m_star: R,
+    /// Square root of the reduced mass m*, kg^1/2.
+    pub sqrt_m_star: R,
     /// v_i - v_j at the centres, m/s.
     pub v_rel: Vector2<R>,
     /// a_i w_i + a_j w_j: the spin part of the contact-point velocity, m/s.
@@ -161,11 +161,21 @@ pub struct ContactForce {
 
 /// What a contact remembers from step to step. Whether it is touching is kept beside
 /// it, densely ([`crate::neighbor::PairList::active`], `World::wall_active`): the sweep
-/// that looks for contacts ending reads that flag for every listed pair.
+/// that looks for contacts ending reads that flag for every listed pair. (The pair list
+/// keeps the two parts in separate arrays, and the energy part only with the energy
+/// ledger on: the force kernel reads and writes the tangential state alone.)
 #[derive(Clone, Copy, Debug, Default)]
 pub struct ContactHistory<H> {
     /// The tangential formulation's state.
     pub tangential: H,
+    /// What the energy accounting carries over.
+    pub energy: EnergyMemory,
+}
+
+/// What a contact's energy accounting carries from one step to the next: the previous
+/// values of the terms it integrates by the trapezoid rule.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct EnergyMemory {
     /// Previous normal damping force (for the trapezoidal energy integrals), N.
     pub fd_prev: f64,
     /// Previous elastic tangential force, N.
@@ -217,7 +227,7 @@ impl<Dm: Damping, T: Tangential> ContactModel<Dm, T> {
     #[inline(always)]
     pub fn force<R: Real>(&self, c: &ContactInput<R>, pm: &PairMaterial<R>, h: &mut T::History<R>) -> ContactState<R> {
         let st = HertzStiffness::new(pm.e_star, pm.g_star, c.r_star, c.dn);
-        let (gn, gt) = Dm::coefficients(pm.beta, st.sn, st.kt, c.m_star);
+        let (gn, gt) = Dm::coefficients(pm, c.sqrt_m_star, st.root);
         let vc = c.contact_velocity();
         let vn = vc.dot(&c.n);
         let elastic_n = st.kn * c.dn;
@@ -251,7 +261,7 @@ impl<Dm: Damping, T: Tangential> ContactModel<Dm, T> {
     ) -> ContactForce {
         let s = self.force(c, pm, &mut h.tangential);
         if ENERGY {
-            self.account(c.n, c.dn, c.dt, &s, h, ledger);
+            self.account(c.n, c.dn, c.dt, &s, &mut h.energy, ledger);
         }
         let tf = s.tangential;
         ContactForce { force: s.force, tangential: tf.elastic + tf.damping, normal: s.normal, kn: s.kn }
@@ -261,7 +271,7 @@ impl<Dm: Damping, T: Tangential> ContactModel<Dm, T> {
     /// overlap `dn`, m, time step `dt`, s), from what [`ContactModel::force`] computed,
     /// into `ledger`; the previous-step values in `h` move on.
     #[inline(always)]
-    pub fn account(&self, n: Vec2, dn: f64, dt: f64, s: &ContactState, h: &mut ContactHistory<T::History<f64>>, ledger: &mut EnergyLedger) {
+    pub fn account(&self, n: Vec2, dn: f64, dt: f64, s: &ContactState, h: &mut EnergyMemory, ledger: &mut EnergyLedger) {
         let tf = s.tangential;
         let dc = s.vc * dt;
         let fd = s.normal - s.elastic_normal;
@@ -282,9 +292,10 @@ impl<Dm: Damping, T: Tangential> ContactModel<Dm, T> {
     }
 
     /// A contact that was touching at the previous step and is not any more: close its
-    /// energy integrals (the force fell to zero over this step) and forget its history.
+    /// energy integrals (the force fell to zero over this step) and forget its history:
+    /// the tangential state `t` and (with `ENERGY`) the energy memory `h`.
     #[inline(always)]
-    pub fn release<const ENERGY: bool>(&self, c_velocity: Vec2, n: Vec2, dt: f64, h: &mut ContactHistory<T::History<f64>>, ledger: &mut EnergyLedger) {
+    pub fn release<const ENERGY: bool>(&self, c_velocity: Vec2, n: Vec2, dt: f64, t: &mut T::History<f64>, h: &mut EnergyMemory, ledger: &mut EnergyLedger) {
         if ENERGY {
             let dc = c_velocity * dt;
             ledger.normal_damping -= 0.5 * h.fd_prev * dc.dot(&n);
@@ -293,7 +304,10 @@ impl<Dm: Damping, T: Tangential> ContactModel<Dm, T> {
                 ledger.tangential_model += -h.ut_prev + 0.5 * h.fte_prev.dot(&dc);
             }
         }
-        *h = ContactHistory::default();
+        *t = Default::default();
+        if ENERGY {
+            *h = EnergyMemory::default();
+        }
     }
 }
 

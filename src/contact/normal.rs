@@ -15,6 +15,8 @@ pub struct HertzStiffness<R = f64> {
     pub sn: R,
     /// Tangential stiffness kt = St, N/m.
     pub kt: R,
+    /// sqrt(R* dn), m (the damping coefficients grow with its square root).
+    pub root: R,
 }
 
 impl<R: Real> HertzStiffness<R> {
@@ -23,7 +25,7 @@ impl<R: Real> HertzStiffness<R> {
         let sqrtval = (r_star * dn).simd_sqrt();
         let sn = k::<R>(2.0) * e_star * sqrtval;
         let kt = k::<R>(8.0) * g_star * sqrtval;
-        HertzStiffness { kn: k::<R>(4.0 / 3.0) * e_star * sqrtval, sn, kt }
+        HertzStiffness { kn: k::<R>(4.0 / 3.0) * e_star * sqrtval, sn, kt, root: sqrtval }
     }
 }
 

@@ -97,7 +97,8 @@ impl Tangential for TotalDisplacement {
         let scale = pick(slide, inp.cap / f_el, R::one());
         let scaled = elastic * scale;
         let before = k::<R>(0.5) * inp.kt * xi.norm_squared();
-        let xi_slid = -scaled / inp.kt;
+        // The displacement that gives the capped force: -scaled/kt = xi scale.
+        let xi_slid = *xi * scale;
         let after = k::<R>(0.5) * inp.kt * xi_slid.norm_squared();
         *xi = pick2(slide, xi_slid, *xi);
         let damping = inp.vt * -inp.gt;
