@@ -10,7 +10,9 @@
 //! pairs). (2) Each thread adds to its grains the cross pairs that come from earlier
 //! ranges (they are first in every grain's sequence), then runs the serial stage's two
 //! passes over the rest of its part (sort out the touching pairs, compute them four at a
-//! time) and adds the results in list order, the cross pairs' where they fall. (3) The
+//! time, adding each result as it comes, in list order), then adds its own cross pairs:
+//! a grain's pairs (g, j) with j in a later range have the largest j, so they are the
+//! last of its sequence. (3) The
 //! energy terms are merged in list order and the largest overlap picked as the serial
 //! loop would. `tests/parallel.rs` checks identical bits with 1 and 2 threads.
 
@@ -31,7 +33,6 @@ const NOT_CROSS: u32 = u32::MAX;
 struct Scratch {
     touching: Vec<u32>,
     released: Vec<u32>,
-    out: Vec<PairOut>,
     pending: Vec<Pending>,
     /// Largest overlap ratio of the part and its pair index.
     worst: (f64, usize),
@@ -195,22 +196,11 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
                 let mut none = EnergyLedger::default();
                 let l = if ENERGY { Ledgers::PerPair(ledgers) } else { Ledgers::One(&mut none) };
                 let list = PairSlices::<T> { pairs: &pairs[part.clone()], consts: &consts[part.clone()], hist, energy, active };
-                if sc.out.len() < nt {
-                    sc.out.resize(nt, PairOut::default());
-                }
-                let mut m = 0;
-                let out = &mut sc.out;
-                let sink = |_, o: PairOut| {
-                    out[m] = o;
-                    m += 1;
-                };
-                compute_pairs::<Dm, T, ENERGY>(&view, list, &sc.touching[..nt], &sc.released[..nr], l, sink, &mut sc.pending);
                 let mut best = (0.0, usize::MAX);
-                let mut add = |k: usize, o: &PairOut, own: bool| {
-                    let (i, j) = (pairs[k][0] as usize - g0, pairs[k][1] as usize);
-                    fl[i] += o.force;
+                let mut add = |k: usize, (i, j): (usize, usize), o: &PairOut, own: bool| {
+                    fl[i - g0] += o.force;
                     if T::FRICTION {
-                        tl[i] -= o.torque[0];
+                        tl[i - g0] -= o.torque[0];
                     }
                     if own {
                         fl[j - g0] -= o.force;
@@ -218,26 +208,19 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
                             tl[j - g0] -= o.torque[1];
                         }
                     }
-                    if o.ratio > best.0 {
+                    if o.ratio > best.0 || (o.ratio == best.0 && k < best.1) {
                         best = (o.ratio, k);
                     }
                 };
-                let mut c = cb[r];
-                for (&kk, o) in sc.touching[..nt].iter().zip(&sc.out) {
-                    let k = part.start + kk as usize;
-                    while c < cb[r + 1] && (cross[c] as usize) < k {
-                        let oc = &cross_out[c];
-                        if oc.ratio > 0.0 {
-                            add(cross[c] as usize, oc, false);
-                        }
-                        c += 1;
-                    }
-                    add(k, o, true);
-                }
-                for c in c..cb[r + 1] {
-                    let oc = &cross_out[c];
+                // Each own pair's force goes to its grains as the kernel hands it over.
+                let sink = |kk: usize, ij: (usize, usize), o: PairOut| add(part.start + kk, ij, &o, true);
+                compute_pairs::<Dm, T, ENERGY>(&view, list, &sc.touching[..nt], &sc.released[..nr], l, sink, &mut sc.pending);
+                // Then the cross pairs from our grains: a grain's pairs (g, j) with j in a
+                // later range are the last of its sequence.
+                for c in cb[r]..cb[r + 1] {
+                    let (oc, k) = (&cross_out[c], cross[c] as usize);
                     if oc.ratio > 0.0 {
-                        add(cross[c] as usize, oc, false);
+                        add(k, (pairs[k][0] as usize, pairs[k][1] as usize), oc, false);
                     }
                 }
                 sc.worst = best;

@@ -242,15 +242,15 @@ pub fn pair_contact<Dm: Damping, T: Tangential, const ENERGY: bool>(
 }
 
 /// Four touching pairs at once, one per SIMD lane (`ks`: their indices in the list):
-/// the same bits as [`one_pair`] gives each of them, handed to `sink` (list index and
-/// output) in lane order; with `ENERGY`, what their accounting needs goes to `pending`.
+/// the same bits as [`one_pair`] gives each of them, handed to `sink` (index in the
+/// part, grains, output) in lane order; with `ENERGY`, what their accounting needs goes to `pending`.
 #[inline(always)]
 fn four_pairs<Dm: Damping, T: Tangential, const ENERGY: bool>(
     w: &PairView<'_, ContactModel<Dm, T>>,
     list: PairSlices<'_, T>,
     single: Option<&PairMaterial<Lanes>>,
     ks: &[u32],
-    sink: &mut impl FnMut((usize, usize), PairOut),
+    sink: &mut impl FnMut(usize, (usize, usize), PairOut),
     pending: &mut [Pending],
 ) {
     let (model, p) = (w.law, w.p);
@@ -283,7 +283,7 @@ fn four_pairs<Dm: Damping, T: Tangential, const ENERGY: bool>(
     for l in 0..LANES {
         hist[ks[l]] = T::lane(&h, l);
         active[ks[l]] = true;
-        sink(ij[l], PairOut { force: lane2(&c.force, l), torque: [torque[0].extract(l), torque[1].extract(l)], ratio: ratio.extract(l) });
+        sink(ks[l], ij[l], PairOut { force: lane2(&c.force, l), torque: [torque[0].extract(l), torque[1].extract(l)], ratio: ratio.extract(l) });
         if ENERGY {
             pending[l] = Pending { n: lane2(&input.n, l), dn: input.dn.extract(l), state: c.lane(l) };
         }
@@ -397,8 +397,8 @@ fn sweep(x: &[Vec2], boundary: &Boundary, pairs: &[[u32; 2]], reach: &[f64], act
 }
 
 /// Compute the pairs `touching` and `released` of a list part (indices from
-/// [`sort_pairs`]): the output of each touching pair goes to `sink` (its list index and
-/// output), in list order. The touching pairs run four at a time in SIMD lanes. With the energy ledger, their accounting (and the released pairs')
+/// [`sort_pairs`]): the output of each touching pair goes to `sink` (its index in the
+/// part, its grains and its output), in list order. The touching pairs run four at a time in SIMD lanes. With the energy ledger, their accounting (and the released pairs')
 /// then follows in list order, so that the ledger sums in the serial order; `pending`
 /// holds what it needs meanwhile.
 #[allow(clippy::too_many_arguments)]
@@ -408,7 +408,7 @@ pub fn compute_pairs<Dm: Damping, T: Tangential, const ENERGY: bool>(
     touching: &[u32],
     released: &[u32],
     mut ledgers: Ledgers<'_>,
-    mut sink: impl FnMut((usize, usize), PairOut),
+    mut sink: impl FnMut(usize, (usize, usize), PairOut),
     pending: &mut Vec<Pending>,
 ) {
     if ENERGY && pending.len() < touching.len() {
@@ -428,7 +428,7 @@ pub fn compute_pairs<Dm: Damping, T: Tangential, const ENERGY: bool>(
         let (i, j) = (pairs[k][0] as usize, pairs[k][1] as usize);
         let d = w.boundary.image(w.p.x[i] - w.p.x[j]);
         let (o, p) = one_pair(w, (i, j), d, &consts[k], &mut hist[k], &mut active[k]);
-        sink((i, j), o);
+        sink(k, (i, j), o);
         if ENERGY {
             pending[m] = p;
         }
@@ -492,7 +492,7 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
         // Each pair's force goes to its grains as it comes, in list order.
         let n = f.len();
         let (fs, ts) = (&mut f[..n], &mut torque[..n]);
-        let sink = |(i, j): (usize, usize), o: PairOut| {
+        let sink = |_, (i, j): (usize, usize), o: PairOut| {
             let (f, torque) = (&mut *fs, &mut *ts);
             f[i] += o.force;
             f[j] -= o.force;
