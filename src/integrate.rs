@@ -69,8 +69,8 @@ impl<L: ContactLaw, const ROT: bool> Stage<L> for InitialIntegrate<ROT> {
         let at = if listed { &w.neighbours.at_build()[..n] } else { &self.origin[..] };
         let far = AtomicBool::new(false);
         let translation = (&mut p.v[..n], &mut p.x[..n], &p.f[..n], &k.dtfm[..], at);
-        let rotation = (&mut p.omega[..n], &mut p.theta[..n], &p.torque[..n], &k.dtfi[..]);
-        w.threads.split(n, (translation, rotation), |((v, x, f, dtfm, at), (omega, theta, torque, dtfi))| {
+        let rotation = (&mut p.omega[..n], &p.torque[..n], &k.dtfi[..]);
+        w.threads.split(n, (translation, rotation), |((v, x, f, dtfm, at), (omega, torque, dtfi))| {
             for (((v, x), f), m) in v.iter_mut().zip(x.iter_mut()).zip(f).zip(dtfm) {
                 *v += *m * *f;
                 *x += dt * *v;
@@ -80,9 +80,8 @@ impl<L: ContactLaw, const ROT: bool> Stage<L> for InitialIntegrate<ROT> {
                 far.store(true, Ordering::Relaxed);
             }
             if ROT {
-                for (((w, th), t), m) in omega.iter_mut().zip(theta.iter_mut()).zip(torque).zip(dtfi) {
+                for ((w, t), m) in omega.iter_mut().zip(torque).zip(dtfi) {
                     *w += *m * *t;
-                    *th += dt * *w;
                 }
             }
         });

@@ -11,8 +11,6 @@ pub struct Particles {
     pub x: Vec<Vec2>,
     /// Velocity, m/s.
     pub v: Vec<Vec2>,
-    /// Rotation angle about z, rad (for output only).
-    pub theta: Vec<f64>,
     /// Spin about z, rad/s.
     pub omega: Vec<f64>,
     /// Force, N.
@@ -44,7 +42,6 @@ impl Particles {
     pub fn push(&mut self, x: Vec2, v: Vec2, omega: f64, r: f64, m: f64, inertia: f64, material: u16) {
         self.x.push(x);
         self.v.push(v);
-        self.theta.push(0.0);
         self.omega.push(omega);
         self.f.push(Vec2::zeros());
         self.torque.push(0.0);

@@ -374,31 +374,45 @@ fn sweep(x: &[Vec2], boundary: &Boundary, pairs: &[[u32; 2]], reach: &[f64], act
     let (np, n) = (pairs.len(), x.len());
     let (reach, active, touching, released, x) = (&reach[..np], &active[..np], &mut touching[..np], &mut released[..np], &x[..n]);
     let (mut nt, mut nr) = (0, 0);
-    let mut put = |k: usize, touch: bool| {
-        let mine = mine(k);
-        touching[nt] = k as u32;
-        released[nr] = k as u32;
-        nt += (touch & mine) as usize;
-        nr += (!touch & active[k] & mine) as usize;
-    };
     let quads = pairs.len() / LANES * LANES;
     for (q, (pq, rq)) in pairs[..quads].chunks_exact(LANES).zip(reach.chunks_exact(LANES)).enumerate() {
         let d: Vector2<Lanes> = boundary.image(gather2(|l| x[pq[l][0] as usize] - x[pq[l][1] as usize]));
         let touch = d.norm_squared().simd_lt(gather(|l| rq[l])).bitmask();
+        let (mut was, mut own) = (0, 0);
         for l in 0..LANES {
-            put(q * LANES + l, touch >> l & 1 != 0);
+            let k = q * LANES + l;
+            was |= (active[k] as u64) << l;
+            own |= (mine(k) as u64) << l;
+        }
+        // Touching: every index written, the count moved on where it touches.
+        for l in 0..LANES {
+            touching[nt] = (q * LANES + l) as u32;
+            nt += (touch & own) as usize >> l & 1;
+        }
+        // Released: a few per step, so a branch that is almost never taken.
+        let gone = !touch & was & own;
+        if gone != 0 {
+            for l in 0..LANES {
+                released[nr] = (q * LANES + l) as u32;
+                nr += gone as usize >> l & 1;
+            }
         }
     }
     for k in quads..pairs.len() {
         let d = boundary.image(x[pairs[k][0] as usize] - x[pairs[k][1] as usize]);
-        put(k, d.norm_squared() < reach[k]);
+        let (touch, mine) = (d.norm_squared() < reach[k], mine(k));
+        touching[nt] = k as u32;
+        released[nr] = k as u32;
+        nt += (touch & mine) as usize;
+        nr += (!touch & active[k] & mine) as usize;
     }
     (nt, nr)
 }
 
 /// Compute the pairs `touching` and `released` of a list part (indices from
 /// [`sort_pairs`]): the output of each touching pair goes to `sink` (its index in the
-/// part, its grains and its output), in list order. The touching pairs run four at a time in SIMD lanes. With the energy ledger, their accounting (and the released pairs')
+/// part, its grains and its output), in list order. The touching pairs run four at a
+/// time in SIMD lanes. With the energy ledger, their accounting (and the released pairs')
 /// then follows in list order, so that the ledger sums in the serial order; `pending`
 /// holds what it needs meanwhile.
 #[allow(clippy::too_many_arguments)]
