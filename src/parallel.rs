@@ -32,6 +32,7 @@ const NOT_CROSS: u32 = u32::MAX;
 #[derive(Default)]
 struct Scratch {
     touching: Vec<u32>,
+    sep: Vec<crate::dim::Vec2>,
     released: Vec<u32>,
     pending: Vec<Pending>,
     /// Largest overlap ratio of the part and its pair index.
@@ -192,7 +193,7 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
                         }
                     }
                 }
-                let (nt, nr) = sort_pairs(&view.p.x, &view.boundary, &pairs[part.clone()], &reach[part.clone()], active, Some(&cross_slot[part.clone()]), &mut sc.touching, &mut sc.released);
+                let (nt, nr) = sort_pairs(&view.p.x, &view.boundary, &pairs[part.clone()], &reach[part.clone()], active, Some(&cross_slot[part.clone()]), &mut sc.touching, &mut sc.sep, &mut sc.released);
                 let mut none = EnergyLedger::default();
                 let l = if ENERGY { Ledgers::PerPair(ledgers) } else { Ledgers::One(&mut none) };
                 let list = PairSlices::<T> { pairs: &pairs[part.clone()], consts: &consts[part.clone()], hist, energy, active };
@@ -214,7 +215,7 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
                 };
                 // Each own pair's force goes to its grains as the kernel hands it over.
                 let sink = |kk: usize, ij: (usize, usize), o: PairOut| add(part.start + kk, ij, &o, true);
-                compute_pairs::<Dm, T, ENERGY>(&view, list, &sc.touching[..nt], &sc.released[..nr], l, sink, &mut sc.pending);
+                compute_pairs::<Dm, T, ENERGY>(&view, list, &sc.touching[..nt], &sc.sep[..nt], &sc.released[..nr], l, sink, &mut sc.pending);
                 // Then the cross pairs from our grains: a grain's pairs (g, j) with j in a
                 // later range are the last of its sequence.
                 for c in cb[r]..cb[r + 1] {

@@ -241,7 +241,8 @@ pub fn pair_contact<Dm: Damping, T: Tangential, const ENERGY: bool>(
     o
 }
 
-/// Four touching pairs at once, one per SIMD lane (`ks`: their indices in the list):
+/// Four touching pairs at once, one per SIMD lane (`ks`: their indices in the list, `ds`
+/// their separations):
 /// the same bits as [`one_pair`] gives each of them, handed to `sink` (index in the
 /// part, grains, output) in lane order; with `ENERGY`, what their accounting needs goes to `pending`.
 #[inline(always)]
@@ -250,6 +251,7 @@ fn four_pairs<Dm: Damping, T: Tangential, const ENERGY: bool>(
     list: PairSlices<'_, T>,
     single: Option<&PairMaterial<Lanes>>,
     ks: &[u32],
+    ds: &[Vec2],
     sink: &mut impl FnMut(usize, (usize, usize), PairOut),
     pending: &mut [Pending],
 ) {
@@ -260,14 +262,14 @@ fn four_pairs<Dm: Damping, T: Tangential, const ENERGY: bool>(
     let np = list.pairs.len();
     let (pairs, consts, hist, active) = (&list.pairs[..np], &list.consts[..np], &mut list.hist[..np], &mut list.active[..np]);
     let n = p.x.len();
-    let (x, v, r, omega) = (&p.x[..n], &p.v[..n], &p.r[..n], &p.omega[..n]);
+    let (v, r, omega) = (&p.v[..n], &p.r[..n], &p.omega[..n]);
     let ks: [usize; LANES] = std::array::from_fn(|l| ks[l] as usize);
     let ij: [(usize, usize); LANES] = std::array::from_fn(|l| {
         let q = pairs[ks[l]];
         (q[0] as usize, q[1] as usize)
     });
     let pc: [&PairConst; LANES] = std::array::from_fn(|l| &consts[ks[l]]);
-    let d = gather2(|l| w.boundary.image(x[ij[l].0] - x[ij[l].1]));
+    let d = gather2(|l| ds[l]);
     let (ri, rj) = (gather(|l| r[ij[l].0]), gather(|l| r[ij[l].1]));
     let (wi, wj) = if T::FRICTION { (gather(|l| omega[ij[l].0]), gather(|l| omega[ij[l].1])) } else { (Lanes::splat(0.0), Lanes::splat(0.0)) };
     let v_rel = gather2(|l| v[ij[l].0] - v[ij[l].1]);
@@ -349,19 +351,21 @@ impl Ledgers<'_> {
 
 /// The pairs of a list part that are touching, and those that were at the previous step
 /// and are not any more, as indices into the part, in list order: the first `nt` of
-/// `touching` and the first `nr` of `released`, `(nt, nr)` returned. `reach` holds each
+/// `touching` and the first `nr` of `released`, `(nt, nr)` returned; `sep[m]` is the
+/// separation (minimum image, i minus j) of pair `touching[m]`. `reach` holds each
 /// pair's `(r_i + r_j)^2` ([`crate::neighbor::PairList::reach`]). `skip` (if given)
 /// leaves out pairs computed elsewhere. No branch per pair, and the lists keep their
 /// length from step to step (no clearing).
 #[allow(clippy::too_many_arguments)]
-pub fn sort_pairs(x: &[Vec2], boundary: &Boundary, pairs: &[[u32; 2]], reach: &[f64], active: &[bool], skip: Option<&[u32]>, touching: &mut Vec<u32>, released: &mut Vec<u32>) -> (usize, usize) {
+pub fn sort_pairs(x: &[Vec2], boundary: &Boundary, pairs: &[[u32; 2]], reach: &[f64], active: &[bool], skip: Option<&[u32]>, touching: &mut Vec<u32>, sep: &mut Vec<Vec2>, released: &mut Vec<u32>) -> (usize, usize) {
     if touching.len() < pairs.len() {
         touching.resize(pairs.len(), 0);
+        sep.resize(pairs.len(), Vec2::zeros());
         released.resize(pairs.len(), 0);
     }
     match skip {
-        None => sweep(x, boundary, pairs, reach, active, |_| true, touching, released),
-        Some(s) => sweep(x, boundary, pairs, reach, active, |k| s[k] == u32::MAX, touching, released),
+        None => sweep(x, boundary, pairs, reach, active, |_| true, touching, sep, released),
+        Some(s) => sweep(x, boundary, pairs, reach, active, |k| s[k] == u32::MAX, touching, sep, released),
     }
 }
 
@@ -369,10 +373,10 @@ pub fn sort_pairs(x: &[Vec2], boundary: &Boundary, pairs: &[[u32; 2]], reach: &[
 /// indices appended where they belong.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-fn sweep(x: &[Vec2], boundary: &Boundary, pairs: &[[u32; 2]], reach: &[f64], active: &[bool], mine: impl Fn(usize) -> bool, touching: &mut [u32], released: &mut [u32]) -> (usize, usize) {
+fn sweep(x: &[Vec2], boundary: &Boundary, pairs: &[[u32; 2]], reach: &[f64], active: &[bool], mine: impl Fn(usize) -> bool, touching: &mut [u32], sep: &mut [Vec2], released: &mut [u32]) -> (usize, usize) {
     // Cut to one length each: one bounds check per index.
     let (np, n) = (pairs.len(), x.len());
-    let (reach, active, touching, released, x) = (&reach[..np], &active[..np], &mut touching[..np], &mut released[..np], &x[..n]);
+    let (reach, active, touching, sep, released, x) = (&reach[..np], &active[..np], &mut touching[..np], &mut sep[..np], &mut released[..np], &x[..n]);
     let (mut nt, mut nr) = (0, 0);
     let quads = pairs.len() / LANES * LANES;
     for (q, (pq, rq)) in pairs[..quads].chunks_exact(LANES).zip(reach.chunks_exact(LANES)).enumerate() {
@@ -387,6 +391,7 @@ fn sweep(x: &[Vec2], boundary: &Boundary, pairs: &[[u32; 2]], reach: &[f64], act
         // Touching: every index written, the count moved on where it touches.
         for l in 0..LANES {
             touching[nt] = (q * LANES + l) as u32;
+            sep[nt] = lane2(&d, l);
             nt += (touch & own) as usize >> l & 1;
         }
         // Released: a few per step, so a branch that is almost never taken.
@@ -402,6 +407,7 @@ fn sweep(x: &[Vec2], boundary: &Boundary, pairs: &[[u32; 2]], reach: &[f64], act
         let d = boundary.image(x[pairs[k][0] as usize] - x[pairs[k][1] as usize]);
         let (touch, mine) = (d.norm_squared() < reach[k], mine(k));
         touching[nt] = k as u32;
+        sep[nt] = d;
         released[nr] = k as u32;
         nt += (touch & mine) as usize;
         nr += (!touch & active[k] & mine) as usize;
@@ -420,6 +426,7 @@ pub fn compute_pairs<Dm: Damping, T: Tangential, const ENERGY: bool>(
     w: &PairView<'_, ContactModel<Dm, T>>,
     list: PairSlices<'_, T>,
     touching: &[u32],
+    sep: &[Vec2],
     released: &[u32],
     mut ledgers: Ledgers<'_>,
     mut sink: impl FnMut(usize, (usize, usize), PairOut),
@@ -433,15 +440,14 @@ pub fn compute_pairs<Dm: Damping, T: Tangential, const ENERGY: bool>(
     let single = w.pair_table.single().map(|m| PairMaterial::gather([m; LANES]));
     let PairSlices { pairs, consts, hist, energy, active } = list;
     let mut pend = pending.chunks_exact_mut(LANES);
-    for ks in touching[..quads].chunks_exact(LANES) {
+    for (ks, ds) in touching[..quads].chunks_exact(LANES).zip(sep.chunks_exact(LANES)) {
         let slices = PairSlices::<T> { pairs, consts, hist: &mut *hist, energy: &mut [], active: &mut *active };
-        four_pairs::<Dm, T, ENERGY>(w, slices, single.as_ref(), ks, &mut sink, if ENERGY { pend.next().expect("a slot per pair") } else { &mut [] });
+        four_pairs::<Dm, T, ENERGY>(w, slices, single.as_ref(), ks, ds, &mut sink, if ENERGY { pend.next().expect("a slot per pair") } else { &mut [] });
     }
     for (m, &k) in touching.iter().enumerate().skip(quads) {
         let k = k as usize;
         let (i, j) = (pairs[k][0] as usize, pairs[k][1] as usize);
-        let d = w.boundary.image(w.p.x[i] - w.p.x[j]);
-        let (o, p) = one_pair(w, (i, j), d, &consts[k], &mut hist[k], &mut active[k]);
+        let (o, p) = one_pair(w, (i, j), sep[m], &consts[k], &mut hist[k], &mut active[k]);
         sink(k, (i, j), o);
         if ENERGY {
             pending[m] = p;
@@ -486,6 +492,7 @@ pub struct PairView<'a, L: ContactLaw> {
 #[derive(Default)]
 pub struct PairForces<const ENERGY: bool> {
     touching: Vec<u32>,
+    sep: Vec<Vec2>,
     released: Vec<u32>,
     pending: Vec<Pending>,
 }
@@ -499,8 +506,8 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
         let mut f = std::mem::take(&mut w.p.f);
         let mut torque = std::mem::take(&mut w.p.torque);
         let (pairs, consts) = (&w.pairs.pairs, &w.pairs.consts);
-        let (nt, nr) = sort_pairs(&w.p.x, &w.boundary, pairs, &w.pairs.reach, &w.pairs.active, None, &mut self.touching, &mut self.released);
-        let (touching, released) = (&self.touching[..nt], &self.released[..nr]);
+        let (nt, nr) = sort_pairs(&w.p.x, &w.boundary, pairs, &w.pairs.reach, &w.pairs.active, None, &mut self.touching, &mut self.sep, &mut self.released);
+        let (touching, sep, released) = (&self.touching[..nt], &self.sep[..nt], &self.released[..nr]);
         let view = PairView { p: &w.p, boundary: w.boundary, law: w.law, pair_table: &w.pair_table, dt: w.dt };
         let list = PairSlices::<T> { pairs, consts, hist: &mut w.pairs.hist, energy: &mut w.pairs.energy, active: &mut w.pairs.active };
         // Each pair's force goes to its grains as it comes, in list order.
@@ -518,7 +525,7 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
                 worst = (o.ratio, i, j);
             }
         };
-        compute_pairs::<Dm, T, ENERGY>(&view, list, touching, released, Ledgers::One(&mut w.ledger), sink, &mut self.pending);
+        compute_pairs::<Dm, T, ENERGY>(&view, list, touching, sep, released, Ledgers::One(&mut w.ledger), sink, &mut self.pending);
         w.p.f = f;
         w.p.torque = torque;
         w.max_overlap = worst;
