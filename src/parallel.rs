@@ -22,7 +22,7 @@ use crate::contact::tangential::Tangential;
 use crate::error::Error;
 use crate::contact::EnergyMemory;
 use crate::observe::energy::EnergyLedger;
-use crate::pipeline::{Ledgers, PairOut, PairSlices, PairView, Pending, Stage, compute_pairs, pair_contact, sort_pairs};
+use crate::pipeline::{Ledgers, PairOut, PairSlices, PairView, Stage, compute_pairs, pair_contact, sort_pairs};
 use crate::sim::World;
 use crate::threads::Threads;
 
@@ -34,7 +34,7 @@ struct Scratch {
     touching: Vec<u32>,
     sep: Vec<crate::dim::Vec2>,
     released: Vec<u32>,
-    pending: Vec<Pending>,
+    pending: Vec<crate::contact::EnergyTerms>,
     /// Largest overlap ratio of the part and its pair index.
     worst: (f64, usize),
 }

@@ -11,7 +11,7 @@ use simba::simd::{SimdBool, SimdPartialOrd, SimdValue};
 use crate::boundary::Boundary;
 use crate::contact::damping::Damping;
 use crate::contact::tangential::Tangential;
-use crate::contact::{ContactInput, ContactLaw, ContactModel, EnergyMemory, LeverArm};
+use crate::contact::{ContactInput, ContactLaw, ContactModel, EnergyMemory, EnergyTerms, LeverArm};
 use crate::dim::{Vec2, cross};
 use crate::lanes::{LANES, Lanes, Real, gather, gather2, lane2};
 use crate::material::PairMaterial;
@@ -242,9 +242,9 @@ pub fn pair_contact<Dm: Damping, T: Tangential, const ENERGY: bool>(
 }
 
 /// Four touching pairs at once, one per SIMD lane (`ks`: their indices in the list, `ds`
-/// their separations):
-/// the same bits as [`one_pair`] gives each of them, handed to `sink` (index in the
-/// part, grains, output) in lane order; with `ENERGY`, what their accounting needs goes to `pending`.
+/// their separations): the same bits as [`one_pair`] gives each of them, handed to
+/// `sink` (index in the part, grains, output) in lane order; with `ENERGY`, their energy
+/// terms (also in lanes, their energy memories moved on) go to `pending`.
 #[inline(always)]
 fn four_pairs<Dm: Damping, T: Tangential, const ENERGY: bool>(
     w: &PairView<'_, ContactModel<Dm, T>>,
@@ -253,7 +253,7 @@ fn four_pairs<Dm: Damping, T: Tangential, const ENERGY: bool>(
     ks: &[u32],
     ds: &[Vec2],
     sink: &mut impl FnMut(usize, (usize, usize), PairOut),
-    pending: &mut [Pending],
+    pending: &mut [EnergyTerms],
 ) {
     let (model, p) = (w.law, w.p);
     let lever = model.options.lever_arm;
@@ -282,12 +282,24 @@ fn four_pairs<Dm: Damping, T: Tangential, const ENERGY: bool>(
     let c = model.force(&input, &pm, &mut h);
     let torque = if T::FRICTION { pair_torque(lever, &input, c.tangential.elastic + c.tangential.damping, ri, rj) } else { [Lanes::splat(0.0); 2] };
     let ratio = input.dn * gather(|l| pc[l].inv_r_min);
+    // With the ledger, the energy terms too, in lanes; the ledger adds them later in
+    // list order.
+    let terms = if ENERGY {
+        let mut e = EnergyMemory::gather(std::array::from_fn(|l| &list.energy[ks[l]]));
+        let t = model.energy_terms(input.n, input.dn, input.dt, &c, &mut e);
+        for l in 0..LANES {
+            list.energy[ks[l]] = e.lane(l);
+        }
+        t
+    } else {
+        EnergyTerms::default()
+    };
     for l in 0..LANES {
         hist[ks[l]] = T::lane(&h, l);
         active[ks[l]] = true;
         sink(ks[l], ij[l], PairOut { force: lane2(&c.force, l), torque: [torque[0].extract(l), torque[1].extract(l)], ratio: ratio.extract(l) });
         if ENERGY {
-            pending[l] = Pending { n: lane2(&input.n, l), dn: input.dn.extract(l), state: c.lane(l) };
+            pending[l] = terms.lane(l);
         }
     }
 }
@@ -302,7 +314,7 @@ fn one_pair<Dm: Damping, T: Tangential>(
     pc: &PairConst,
     h: &mut T::History<f64>,
     active: &mut bool,
-) -> (PairOut, Pending) {
+) -> (PairOut, Touch) {
     let (model, p) = (w.law, w.p);
     let lever = model.options.lever_arm;
     let input = pair_input::<f64, T>(lever, d, p.r[i], p.r[j], p.omega[i], p.omega[j], p.v[i] - p.v[j], pc.r_star, pc.sqrt_m_star, w.dt);
@@ -310,13 +322,13 @@ fn one_pair<Dm: Damping, T: Tangential>(
     let c = model.force(&input, pm, h);
     *active = true;
     let torque = if T::FRICTION { pair_torque(lever, &input, c.tangential.elastic + c.tangential.damping, p.r[i], p.r[j]) } else { [0.0, 0.0] };
-    (PairOut { force: c.force, torque, ratio: input.dn * pc.inv_r_min }, Pending { n: input.n, dn: input.dn, state: c })
+    (PairOut { force: c.force, torque, ratio: input.dn * pc.inv_r_min }, Touch { n: input.n, dn: input.dn, state: c })
 }
 
-/// What a touching pair's energy accounting needs, kept until the pairs are accounted in
-/// list order: the normal, the overlap (m), and the step's contact state.
+/// What a touching pair's energy accounting needs: the normal, the overlap (m), and the
+/// step's contact state.
 #[derive(Clone, Copy, Debug, Default)]
-pub struct Pending {
+struct Touch {
     n: Vec2,
     dn: f64,
     state: crate::contact::model::ContactState,
@@ -418,9 +430,9 @@ fn sweep(x: &[Vec2], boundary: &Boundary, pairs: &[[u32; 2]], reach: &[f64], act
 /// Compute the pairs `touching` and `released` of a list part (indices from
 /// [`sort_pairs`]): the output of each touching pair goes to `sink` (its index in the
 /// part, its grains and its output), in list order. The touching pairs run four at a
-/// time in SIMD lanes. With the energy ledger, their accounting (and the released pairs')
-/// then follows in list order, so that the ledger sums in the serial order; `pending`
-/// holds what it needs meanwhile.
+/// time in SIMD lanes, their energy terms too (with the energy ledger); the ledger then
+/// adds those and the released pairs' in list order, so that it sums in the serial
+/// order; `pending` holds the terms meanwhile.
 #[allow(clippy::too_many_arguments)]
 pub fn compute_pairs<Dm: Damping, T: Tangential, const ENERGY: bool>(
     w: &PairView<'_, ContactModel<Dm, T>>,
@@ -430,10 +442,10 @@ pub fn compute_pairs<Dm: Damping, T: Tangential, const ENERGY: bool>(
     released: &[u32],
     mut ledgers: Ledgers<'_>,
     mut sink: impl FnMut(usize, (usize, usize), PairOut),
-    pending: &mut Vec<Pending>,
+    pending: &mut Vec<EnergyTerms>,
 ) {
     if ENERGY && pending.len() < touching.len() {
-        pending.resize(touching.len(), Pending::default());
+        pending.resize(touching.len(), EnergyTerms::default());
     }
     let quads = touching.len() / LANES * LANES;
     // One material: its lanes once, not a table lookup per lane.
@@ -441,7 +453,7 @@ pub fn compute_pairs<Dm: Damping, T: Tangential, const ENERGY: bool>(
     let PairSlices { pairs, consts, hist, energy, active } = list;
     let mut pend = pending.chunks_exact_mut(LANES);
     for (ks, ds) in touching[..quads].chunks_exact(LANES).zip(sep.chunks_exact(LANES)) {
-        let slices = PairSlices::<T> { pairs, consts, hist: &mut *hist, energy: &mut [], active: &mut *active };
+        let slices = PairSlices::<T> { pairs, consts, hist: &mut *hist, energy: &mut *energy, active: &mut *active };
         four_pairs::<Dm, T, ENERGY>(w, slices, single.as_ref(), ks, ds, &mut sink, if ENERGY { pend.next().expect("a slot per pair") } else { &mut [] });
     }
     for (m, &k) in touching.iter().enumerate().skip(quads) {
@@ -450,7 +462,7 @@ pub fn compute_pairs<Dm: Damping, T: Tangential, const ENERGY: bool>(
         let (o, p) = one_pair(w, (i, j), sep[m], &consts[k], &mut hist[k], &mut active[k]);
         sink(k, (i, j), o);
         if ENERGY {
-            pending[m] = p;
+            pending[m] = w.law.energy_terms(p.n, p.dn, w.dt, &p.state, &mut energy[k]);
         }
     }
     let mut none = EnergyLedger::default();
@@ -465,8 +477,8 @@ pub fn compute_pairs<Dm: Damping, T: Tangential, const ENERGY: bool>(
     let (mut a, mut b) = (0, 0);
     while a < touching.len() || b < released.len() {
         if b == released.len() || (a < touching.len() && touching[a] < released[b]) {
-            let (k, p) = (touching[a] as usize, &pending[a]);
-            w.law.account(p.n, p.dn, w.dt, &p.state, &mut energy[k], ledgers.get(k));
+            let k = touching[a] as usize;
+            w.law.add_terms(&pending[a], ledgers.get(k));
             a += 1;
         } else {
             let k = released[b] as usize;
@@ -494,7 +506,7 @@ pub struct PairForces<const ENERGY: bool> {
     touching: Vec<u32>,
     sep: Vec<Vec2>,
     released: Vec<u32>,
-    pending: Vec<Pending>,
+    pending: Vec<EnergyTerms>,
 }
 
 impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> for PairForces<ENERGY> {

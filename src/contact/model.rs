@@ -174,16 +174,68 @@ pub struct ContactHistory<H> {
 
 /// What a contact's energy accounting carries from one step to the next: the previous
 /// values of the terms it integrates by the trapezoid rule.
+/// (`R = Lanes`: of four contacts.)
 #[derive(Clone, Copy, Debug, Default)]
-pub struct EnergyMemory {
+pub struct EnergyMemory<R: Real = f64> {
     /// Previous normal damping force (for the trapezoidal energy integrals), N.
-    pub fd_prev: f64,
+    pub fd_prev: R,
     /// Previous elastic tangential force, N.
-    pub fte_prev: Vec2,
+    pub fte_prev: Vector2<R>,
     /// Previous tangential damping force, N.
-    pub ftd_prev: Vec2,
+    pub ftd_prev: Vector2<R>,
     /// Previous tangential elastic energy, J.
-    pub ut_prev: f64,
+    pub ut_prev: R,
+}
+
+impl EnergyMemory<crate::lanes::Lanes> {
+    /// Four contacts' memories in lanes.
+    #[inline(always)]
+    pub fn gather(h: [&EnergyMemory; crate::lanes::LANES]) -> Self {
+        use crate::lanes::{gather, gather2};
+        EnergyMemory { fd_prev: gather(|l| h[l].fd_prev), fte_prev: gather2(|l| h[l].fte_prev), ftd_prev: gather2(|l| h[l].ftd_prev), ut_prev: gather(|l| h[l].ut_prev) }
+    }
+    /// The memory in lane `l`.
+    #[inline(always)]
+    pub fn lane(&self, l: usize) -> EnergyMemory {
+        use crate::lanes::lane2;
+        use simba::simd::SimdValue;
+        EnergyMemory { fd_prev: self.fd_prev.extract(l), fte_prev: lane2(&self.fte_prev, l), ftd_prev: lane2(&self.ftd_prev, l), ut_prev: self.ut_prev.extract(l) }
+    }
+}
+
+/// What one step of one touching contact (or of four, in lanes) adds to the energy
+/// ledger, J: [`ContactModel::add_terms`] adds them, so that a ledger sums the same
+/// numbers in the same order whether the terms were computed alone or in lanes.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct EnergyTerms<R: Real = f64> {
+    /// Work of the normal damping force over the step (subtracted), J.
+    pub normal_damping: R,
+    /// Elastic energy in the normal spring now, J.
+    pub elastic_normal: R,
+    /// Work of the tangential damping force over the step (subtracted), J.
+    pub tangential_damping: R,
+    /// Energy lost to sliding, J.
+    pub friction: R,
+    /// Work of the tangential model (stiffness and frame changes), J.
+    pub tangential_model: R,
+    /// Elastic energy in the tangential spring now, J.
+    pub elastic_tangential: R,
+}
+
+impl EnergyTerms<crate::lanes::Lanes> {
+    /// The terms of lane `l`.
+    #[inline(always)]
+    pub fn lane(&self, l: usize) -> EnergyTerms {
+        use simba::simd::SimdValue;
+        EnergyTerms {
+            normal_damping: self.normal_damping.extract(l),
+            elastic_normal: self.elastic_normal.extract(l),
+            tangential_damping: self.tangential_damping.extract(l),
+            friction: self.friction.extract(l),
+            tangential_model: self.tangential_model.extract(l),
+            elastic_tangential: self.elastic_tangential.extract(l),
+        }
+    }
 }
 
 /// A contact law: the trait the stages are generic over.
@@ -272,23 +324,44 @@ impl<Dm: Damping, T: Tangential> ContactModel<Dm, T> {
     /// into `ledger`; the previous-step values in `h` move on.
     #[inline(always)]
     pub fn account(&self, n: Vec2, dn: f64, dt: f64, s: &ContactState, h: &mut EnergyMemory, ledger: &mut EnergyLedger) {
+        let t = self.energy_terms(n, dn, dt, s, h);
+        self.add_terms(&t, ledger);
+    }
+
+    /// The energy terms of one step of a touching contact (of four, in lanes): see
+    /// [`ContactModel::account`]. No branch on the data: the same bits per lane as alone.
+    #[inline(always)]
+    pub fn energy_terms<R: Real>(&self, n: Vector2<R>, dn: R, dt: R, s: &ContactState<R>, h: &mut EnergyMemory<R>) -> EnergyTerms<R> {
         let tf = s.tangential;
         let dc = s.vc * dt;
         let fd = s.normal - s.elastic_normal;
-        ledger.normal_damping -= 0.5 * (h.fd_prev + fd) * dc.dot(&n);
-        ledger.elastic_normal += hertz_energy(s.kn, dn);
+        let mut t = EnergyTerms { normal_damping: k::<R>(0.5) * (h.fd_prev + fd) * dc.dot(&n), elastic_normal: hertz_energy(s.kn, dn), ..Default::default() };
         if T::FRICTION {
-            let ut = if s.kt > 0.0 { 0.5 * tf.elastic.norm_squared() / s.kt } else { 0.0 };
-            ledger.tangential_damping -= 0.5 * (h.ftd_prev + tf.damping).dot(&dc);
-            let w_spring = 0.5 * (h.fte_prev + tf.elastic).dot(&dc);
-            ledger.friction += tf.slip_energy;
-            ledger.tangential_model += ut - h.ut_prev + tf.slip_energy + w_spring;
-            ledger.elastic_tangential += ut;
+            let ut = pick(s.kt.simd_gt(R::zero()), k::<R>(0.5) * tf.elastic.norm_squared() / s.kt, R::zero());
+            t.tangential_damping = k::<R>(0.5) * (h.ftd_prev + tf.damping).dot(&dc);
+            let w_spring = k::<R>(0.5) * (h.fte_prev + tf.elastic).dot(&dc);
+            t.friction = tf.slip_energy;
+            t.tangential_model = ut - h.ut_prev + tf.slip_energy + w_spring;
+            t.elastic_tangential = ut;
             h.fte_prev = tf.elastic;
             h.ftd_prev = tf.damping;
             h.ut_prev = ut;
         }
         h.fd_prev = fd;
+        t
+    }
+
+    /// Add one contact's energy terms to `ledger`.
+    #[inline(always)]
+    pub fn add_terms(&self, t: &EnergyTerms, ledger: &mut EnergyLedger) {
+        ledger.normal_damping -= t.normal_damping;
+        ledger.elastic_normal += t.elastic_normal;
+        if T::FRICTION {
+            ledger.tangential_damping -= t.tangential_damping;
+            ledger.friction += t.friction;
+            ledger.tangential_model += t.tangential_model;
+            ledger.elastic_tangential += t.elastic_tangential;
+        }
     }
 
     /// A contact that was touching at the previous step and is not any more: close its

@@ -31,6 +31,6 @@ impl<R: Real> HertzStiffness<R> {
 
 /// Elastic energy stored in a Hertz contact, `2/5 kn dn^2`, J.
 #[inline(always)]
-pub fn hertz_energy(kn: f64, dn: f64) -> f64 {
-    0.4 * kn * dn * dn
+pub fn hertz_energy<R: Real>(kn: R, dn: R) -> R {
+    k::<R>(0.4) * kn * dn * dn
 }
