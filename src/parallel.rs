@@ -6,8 +6,9 @@
 //! pairs (g, j). The grains (stored along a Z curve, so index ranges are compact in space)
 //! are split into one index range per thread, balanced by pair count; the pairs whose
 //! first grain is in a range are a contiguous part of the list, with their histories.
-//! (1) Each thread computes the few pairs of its part that join two ranges ("cross"
-//! pairs). (2) Each thread adds to its grains the cross pairs that come from earlier
+//! (1) The few pairs that join two ranges ("cross" pairs; nearly all are free grains of
+//! the first range against the rough walls' grains, last in the index space) are
+//! computed, shared evenly between the threads. (2) Each thread adds to its grains the cross pairs that come from earlier
 //! ranges (they are first in every grain's sequence), then runs the serial stage's two
 //! passes over the rest of its part (sort out the touching pairs, compute them four at a
 //! time, adding each result as it comes, in list order), then adds its own cross pairs:
@@ -158,18 +159,26 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
         let (cross, cross_slot, incoming) = (&self.cross, &self.cross_slot, &self.incoming);
         let threads = &self.threads;
         {
-            // (1) Each range's cross pairs, into their slots.
-            let parts = cut(&mut w.pairs.hist, pb)
+            // (1) The cross pairs, into their slots, shared evenly between the threads
+            // whoever owns them (nearly all have their first grain in the first range: the
+            // rough walls' grains are last in the index space): thread r takes slots
+            // sb[r]..sb[r + 1], whose pairs lie in the list part kb[r]..kb[r + 1].
+            let t = self.scratch.len();
+            let sb: Vec<usize> = (0..=t).map(|r| r * cross.len() / t).collect();
+            let kb: Vec<usize> = sb.iter().enumerate().map(|(r, &s)| if r == 0 { 0 } else if s < cross.len() { cross[s] as usize } else { np }).collect();
+            let kb_ledger: Vec<usize> = if ENERGY { kb.clone() } else { vec![0; kb.len()] };
+            let parts = cut(&mut w.pairs.hist, &kb)
                 .into_iter()
-                .zip(cut(&mut w.pairs.active, pb))
-                .zip(cut(&mut self.ledgers, &ledger_bounds).into_iter().zip(cut(&mut w.pairs.energy, &ledger_bounds)))
-                .zip(cut(&mut self.cross_out, cb));
+                .zip(cut(&mut w.pairs.active, &kb))
+                .zip(cut(&mut self.ledgers, &kb_ledger).into_iter().zip(cut(&mut w.pairs.energy, &kb_ledger)))
+                .zip(cut(&mut self.cross_out, &sb));
             threads.each(parts.collect(), |r, (((hist, active), (ledgers, energy)), out)| {
                 let (mut none, mut no_memory) = (EnergyLedger::default(), EnergyMemory::default());
-                for (s, o) in (cb[r]..cb[r + 1]).zip(out.iter_mut()) {
+                let k0 = kb[r];
+                for (s, o) in (sb[r]..sb[r + 1]).zip(out.iter_mut()) {
                     let k = cross[s] as usize;
-                    let (l, e) = if ENERGY { (&mut ledgers[k - pb[r]], &mut energy[k - pb[r]]) } else { (&mut none, &mut no_memory) };
-                    *o = pair_contact::<Dm, T, ENERGY>(&view, pairs[k], &consts[k], &mut hist[k - pb[r]], e, &mut active[k - pb[r]], l);
+                    let (l, e) = if ENERGY { (&mut ledgers[k - k0], &mut energy[k - k0]) } else { (&mut none, &mut no_memory) };
+                    *o = pair_contact::<Dm, T, ENERGY>(&view, pairs[k], &consts[k], &mut hist[k - k0], e, &mut active[k - k0], l);
                 }
             });
             let cross_out = &self.cross_out;
