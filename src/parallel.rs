@@ -8,13 +8,13 @@
 //! first grain is in a range are a contiguous part of the list, with their histories.
 //! (1) The few pairs that join two ranges ("cross" pairs; nearly all are free grains of
 //! the first range against the rough walls' grains, last in the index space) are
-//! computed, shared evenly between the threads. (2) Each thread adds to its grains the cross pairs that come from earlier
-//! ranges (they are first in every grain's sequence), then runs the serial stage's two
-//! passes over the rest of its part (sort out the touching pairs, compute them four at a
-//! time, adding each result as it comes, in list order), then adds its own cross pairs:
-//! a grain's pairs (g, j) with j in a later range have the largest j, so they are the
-//! last of its sequence. (3) The
-//! energy terms are merged in list order and the largest overlap picked as the serial
+//! computed, shared evenly between the threads. (2) Each thread adds to its grains the
+//! cross pairs that come from earlier ranges (they are first in every grain's sequence),
+//! then runs the serial stage's two passes over the rest of its part (sort out the
+//! touching pairs, compute them four at a time, adding each result as it comes, in list
+//! order), then adds its own cross pairs: a grain's pairs (g, j) with j in a later range
+//! have the largest j, so they are the last of its sequence. (3) The energy terms are
+//! merged in list order and the largest overlap picked as the serial
 //! loop would. `tests/parallel.rs` checks identical bits with 1 and 2 threads.
 
 use crate::contact::ContactModel;
