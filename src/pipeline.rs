@@ -287,8 +287,8 @@ fn four_pairs<Dm: Damping, T: Tangential, const ENERGY: bool>(
     let terms = if ENERGY {
         let mut e = EnergyMemory::gather(std::array::from_fn(|l| &list.energy[ks[l]]));
         let t = model.energy_terms(input.n, input.dn, input.dt, &c, &mut e);
-        for l in 0..LANES {
-            list.energy[ks[l]] = e.lane(l);
+        for (l, &k) in ks.iter().enumerate() {
+            list.energy[k] = e.lane(l);
         }
         t
     } else {
