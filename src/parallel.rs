@@ -62,6 +62,12 @@ pub struct ParallelPairForces<const ENERGY: bool> {
     built_for: u64,
 }
 
+/// Where to cut the per-pair ledgers and energy memories for list parts cut at `bounds`:
+/// the same places with the energy ledger, else nowhere (they are empty).
+fn energy_cuts<const ENERGY: bool>(bounds: &[usize]) -> Vec<usize> {
+    if ENERGY { bounds.to_vec() } else { vec![0; bounds.len()] }
+}
+
 /// `v` cut at `bounds` (from 0 to `v.len()`) into consecutive parts.
 fn cut<'a, T>(mut v: &'a mut [T], bounds: &[usize]) -> Vec<&'a mut [T]> {
     let mut parts = Vec::with_capacity(bounds.len());
@@ -150,7 +156,7 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
         }
         self.ledgers.clear();
         self.ledgers.resize(if ENERGY { np } else { 0 }, EnergyLedger::default());
-        let ledger_bounds: Vec<usize> = if ENERGY { self.pair_bounds.clone() } else { vec![0; self.pair_bounds.len()] };
+        let ledger_bounds = energy_cuts::<ENERGY>(&self.pair_bounds);
         let mut f = std::mem::take(&mut w.p.f);
         let mut torque = std::mem::take(&mut w.p.torque);
         let view = PairView { p: &w.p, boundary: w.boundary, law: w.law, pair_table: &w.pair_table, dt: w.dt };
@@ -166,7 +172,7 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
             let t = self.scratch.len();
             let sb: Vec<usize> = (0..=t).map(|r| r * cross.len() / t).collect();
             let kb: Vec<usize> = sb.iter().enumerate().map(|(r, &s)| if r == 0 { 0 } else if s < cross.len() { cross[s] as usize } else { np }).collect();
-            let kb_ledger: Vec<usize> = if ENERGY { kb.clone() } else { vec![0; kb.len()] };
+            let kb_ledger = energy_cuts::<ENERGY>(&kb);
             let parts = cut(&mut w.pairs.hist, &kb)
                 .into_iter()
                 .zip(cut(&mut w.pairs.active, &kb))

@@ -526,12 +526,11 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
         let n = f.len();
         let (fs, ts) = (&mut f[..n], &mut torque[..n]);
         let sink = |_, (i, j): (usize, usize), o: PairOut| {
-            let (f, torque) = (&mut *fs, &mut *ts);
-            f[i] += o.force;
-            f[j] -= o.force;
+            fs[i] += o.force;
+            fs[j] -= o.force;
             if T::FRICTION {
-                torque[i] -= o.torque[0];
-                torque[j] -= o.torque[1];
+                ts[i] -= o.torque[0];
+                ts[j] -= o.torque[1];
             }
             if o.ratio > worst.0 {
                 worst = (o.ratio, i, j);

@@ -127,25 +127,6 @@ pub struct ContactState<R: Real = f64> {
     pub vc: Vector2<R>,
 }
 
-impl ContactState<crate::lanes::Lanes> {
-    /// The state of the contact in lane `l`.
-    #[inline(always)]
-    pub fn lane(&self, l: usize) -> ContactState {
-        use crate::lanes::lane2;
-        use simba::simd::SimdValue;
-        let t = &self.tangential;
-        ContactState {
-            force: lane2(&self.force, l),
-            tangential: TangentialForce { elastic: lane2(&t.elastic, l), damping: lane2(&t.damping, l), slip_energy: t.slip_energy.extract(l) },
-            normal: self.normal.extract(l),
-            elastic_normal: self.elastic_normal.extract(l),
-            kn: self.kn.extract(l),
-            kt: self.kt.extract(l),
-            vc: lane2(&self.vc, l),
-        }
-    }
-}
-
 /// The force of one contact on grain i (grain j gets the opposite).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct ContactForce {
