@@ -27,8 +27,6 @@ use crate::pipeline::{Ledgers, PairOut, PairSlices, PairView, Stage, compute_pai
 use crate::sim::World;
 use crate::threads::Threads;
 
-const NOT_CROSS: u32 = u32::MAX;
-
 /// One thread's working lists.
 #[derive(Default)]
 struct Scratch {
@@ -47,9 +45,12 @@ pub struct ParallelPairForces<const ENERGY: bool> {
     bounds: Vec<usize>,
     /// Pair index bounds of the ranges' parts of the list.
     pair_bounds: Vec<usize>,
-    /// The pairs joining two ranges, in list order, and each pair's slot among them.
+    /// The pairs joining two ranges, in list order (a pair's slot is its place here),
+    /// and the same as indices into their range's part of the list.
     cross: Vec<u32>,
-    cross_slot: Vec<u32>,
+    cross_in_part: Vec<u32>,
+    /// Length of the list the tables were made for.
+    listed: usize,
     /// Slot bounds of each range's cross pairs (those whose first grain it owns).
     cross_bounds: Vec<usize>,
     cross_out: Vec<PairOut>,
@@ -87,7 +88,8 @@ impl<const ENERGY: bool> ParallelPairForces<ENERGY> {
             bounds: Vec::new(),
             pair_bounds: Vec::new(),
             cross: Vec::new(),
-            cross_slot: Vec::new(),
+            cross_in_part: Vec::new(),
+            listed: 0,
             cross_bounds: Vec::new(),
             cross_out: Vec::new(),
             incoming: Vec::new(),
@@ -121,18 +123,17 @@ impl<const ENERGY: bool> ParallelPairForces<ENERGY> {
         self.pair_bounds = self.bounds.iter().map(|&g| first[g]).collect();
         let range_of = |g: usize, b: &[usize]| b.partition_point(|&x| x <= g) - 1;
         self.cross.clear();
-        self.cross_slot.clear();
+        self.cross_in_part.clear();
         self.cross_bounds = vec![0];
         self.incoming = vec![Vec::new(); t];
         for r in 0..t {
-            for k in self.pair_bounds[r]..self.pair_bounds[r + 1] {
-                let rj = range_of(pairs[k][1] as usize, &self.bounds);
-                if rj == r {
-                    self.cross_slot.push(NOT_CROSS);
-                } else {
+            let k0 = self.pair_bounds[r];
+            for (m, p) in pairs[k0..self.pair_bounds[r + 1]].iter().enumerate() {
+                let rj = range_of(p[1] as usize, &self.bounds);
+                if rj != r {
                     let slot = self.cross.len() as u32;
-                    self.cross_slot.push(slot);
-                    self.cross.push(k as u32);
+                    self.cross_in_part.push(m as u32);
+                    self.cross.push((k0 + m) as u32);
                     self.incoming[rj].push(slot);
                 }
             }
@@ -140,6 +141,7 @@ impl<const ENERGY: bool> ParallelPairForces<ENERGY> {
         }
         self.cross_out.clear();
         self.cross_out.resize(self.cross.len(), PairOut::default());
+        self.listed = pairs.len();
     }
 }
 
@@ -150,7 +152,7 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
     fn run(&mut self, w: &mut World<ContactModel<Dm, T>>) -> Result<(), Error> {
         let n = w.p.len();
         let np = w.pairs.pairs.len();
-        if self.built_for != w.neighbours.builds || self.cross_slot.len() != np || *self.bounds.last().unwrap_or(&usize::MAX) != n {
+        if self.built_for != w.neighbours.builds || self.listed != np || *self.bounds.last().unwrap_or(&usize::MAX) != n {
             self.tables(n, &w.pairs.pairs);
             self.built_for = w.neighbours.builds;
         }
@@ -160,9 +162,10 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
         let mut f = std::mem::take(&mut w.p.f);
         let mut torque = std::mem::take(&mut w.p.torque);
         let view = PairView { p: &w.p, boundary: w.boundary, law: w.law, pair_table: &w.pair_table, dt: w.dt };
-        let (pairs, consts, reach) = (&w.pairs.pairs, &w.pairs.consts, &w.pairs.reach);
+        let (checked, consts, reach) = (w.pairs.pairs.checked(), &w.pairs.consts, &w.pairs.reach);
+        let pairs = checked.pairs();
         let (bounds, pb, cb) = (&self.bounds, &self.pair_bounds, &self.cross_bounds);
-        let (cross, cross_slot, incoming) = (&self.cross, &self.cross_slot, &self.incoming);
+        let (cross, cross_in_part, incoming) = (&self.cross, &self.cross_in_part, &self.incoming);
         let threads = &self.threads;
         {
             // (1) The cross pairs, into their slots, shared evenly between the threads
@@ -208,12 +211,11 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
                         }
                     }
                 }
-                let (nt, nr) = sort_pairs(&view.p.x, &view.boundary, &pairs[part.clone()], &reach[part.clone()], active, Some(&cross_slot[part.clone()]), &mut sc.touching, &mut sc.sep, &mut sc.released);
+                let (nt, nr) = sort_pairs(&view.p.x, &view.boundary, checked.part(part.clone()), &reach[part.clone()], active, &cross_in_part[cb[r]..cb[r + 1]], &mut sc.touching, &mut sc.sep, &mut sc.released);
                 let mut none = EnergyLedger::default();
                 let l = if ENERGY { Ledgers::PerPair(ledgers) } else { Ledgers::One(&mut none) };
-                let list = PairSlices::<T> { pairs: &pairs[part.clone()], consts: &consts[part.clone()], hist, energy, active };
-                let mut best = (0.0, usize::MAX);
-                let mut add = |k: usize, (i, j): (usize, usize), o: &PairOut, own: bool| {
+                let list = PairSlices::<T> { pairs: checked.part(part.clone()), consts: &consts[part.clone()], hist, energy, active };
+                let mut add = |(i, j): (usize, usize), o: &PairOut, own: bool| {
                     fl[i - g0] += o.force;
                     if T::FRICTION {
                         tl[i - g0] -= o.torque[0];
@@ -224,19 +226,20 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
                             tl[j - g0] -= o.torque[1];
                         }
                     }
-                    if o.ratio > best.0 || (o.ratio == best.0 && k < best.1) {
-                        best = (o.ratio, k);
-                    }
                 };
                 // Each own pair's force goes to its grains as the kernel hands it over.
-                let sink = |kk: usize, ij: (usize, usize), o: PairOut| add(part.start + kk, ij, &o, true);
-                compute_pairs::<Dm, T, ENERGY>(&view, list, &sc.touching[..nt], &sc.sep[..nt], &sc.released[..nr], l, sink, &mut sc.pending);
+                let sink = |_, ij: (usize, usize), o: PairOut| add(ij, &o, true);
+                let (ratio, kk) = compute_pairs::<Dm, T, ENERGY>(&view, list, &sc.touching[..nt], &sc.sep[..nt], &sc.released[..nr], l, sink, &mut sc.pending);
+                let mut best = if kk == usize::MAX { (0.0, usize::MAX) } else { (ratio, part.start + kk) };
                 // Then the cross pairs from our grains: a grain's pairs (g, j) with j in a
                 // later range are the last of its sequence.
                 for c in cb[r]..cb[r + 1] {
                     let (oc, k) = (&cross_out[c], cross[c] as usize);
                     if oc.ratio > 0.0 {
-                        add(k, (pairs[k][0] as usize, pairs[k][1] as usize), oc, false);
+                        add((pairs[k][0] as usize, pairs[k][1] as usize), oc, false);
+                        if oc.ratio > best.0 || (oc.ratio == best.0 && k < best.1) {
+                            best = (oc.ratio, k);
+                        }
                     }
                 }
                 sc.worst = best;

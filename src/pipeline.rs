@@ -15,7 +15,7 @@ use crate::contact::{ContactInput, ContactLaw, ContactModel, EnergyMemory, Energ
 use crate::dim::{Vec2, cross};
 use crate::lanes::{LANES, Lanes, Real, gather, gather2, lane2};
 use crate::material::PairMaterial;
-use crate::neighbor::{Neighbours, PairConst};
+use crate::neighbor::{CheckedPairs, Neighbours, PairConst};
 use crate::observe::energy::EnergyLedger;
 use crate::particles::Particles;
 use crate::error::Error;
@@ -246,6 +246,7 @@ pub fn pair_contact<Dm: Damping, T: Tangential, const ENERGY: bool>(
 /// `sink` (index in the part, grains, output) in lane order; with `ENERGY`, their energy
 /// terms (also in lanes, their energy memories moved on) go to `pending`.
 #[inline(always)]
+#[allow(clippy::too_many_arguments)]
 fn four_pairs<Dm: Damping, T: Tangential, const ENERGY: bool>(
     w: &PairView<'_, ContactModel<Dm, T>>,
     list: PairSlices<'_, T>,
@@ -254,15 +255,15 @@ fn four_pairs<Dm: Damping, T: Tangential, const ENERGY: bool>(
     ds: &[Vec2],
     sink: &mut impl FnMut(usize, (usize, usize), PairOut),
     pending: &mut [EnergyTerms],
+    best: &mut (f64, usize),
 ) {
     let (model, p) = (w.law, w.p);
     let lever = model.options.lever_arm;
     // The per-pair and per-grain slices cut to one length each, so that one bounds check
     // per index serves every array it reads.
     let np = list.pairs.len();
-    let (pairs, consts, hist, active) = (&list.pairs[..np], &list.consts[..np], &mut list.hist[..np], &mut list.active[..np]);
-    let n = p.x.len();
-    let (v, r, omega) = (&p.v[..n], &p.r[..n], &p.omega[..n]);
+    let (pairs, consts, hist, active) = (list.pairs.pairs(), &list.consts[..np], &mut list.hist[..np], &mut list.active[..np]);
+    let (v, r, omega) = (list.pairs.of(&p.v), list.pairs.of(&p.r), list.pairs.of(&p.omega));
     let ks: [usize; LANES] = std::array::from_fn(|l| ks[l] as usize);
     let ij: [(usize, usize); LANES] = std::array::from_fn(|l| {
         let q = pairs[ks[l]];
@@ -270,18 +271,36 @@ fn four_pairs<Dm: Damping, T: Tangential, const ENERGY: bool>(
     });
     let pc: [&PairConst; LANES] = std::array::from_fn(|l| &consts[ks[l]]);
     let d = gather2(|l| ds[l]);
-    let (ri, rj) = (gather(|l| r[ij[l].0]), gather(|l| r[ij[l].1]));
-    let (wi, wj) = if T::FRICTION { (gather(|l| omega[ij[l].0]), gather(|l| omega[ij[l].1])) } else { (Lanes::splat(0.0), Lanes::splat(0.0)) };
-    let v_rel = gather2(|l| v[ij[l].0] - v[ij[l].1]);
+    let (ri, rj) = (gather(|l| r.at(ks[l]).0), gather(|l| r.at(ks[l]).1));
+    let (wi, wj) = if T::FRICTION { (gather(|l| omega.at(ks[l]).0), gather(|l| omega.at(ks[l]).1)) } else { (Lanes::splat(0.0), Lanes::splat(0.0)) };
+    let v_rel = gather2(|l| {
+        let (vi, vj) = v.at(ks[l]);
+        vi - vj
+    });
     let input = pair_input::<Lanes, T>(lever, d, ri, rj, wi, wj, v_rel, gather(|l| pc[l].r_star), gather(|l| pc[l].sqrt_m_star), Lanes::splat(w.dt));
     let pm = match single {
         Some(pm) => *pm,
-        None => PairMaterial::gather(std::array::from_fn(|l| w.pair_table.get(p.material[ij[l].0] as usize, p.material[ij[l].1] as usize))),
+        None => {
+            let mat = list.pairs.of(&p.material);
+            PairMaterial::gather(std::array::from_fn(|l| {
+                let (mi, mj) = mat.at(ks[l]);
+                w.pair_table.get(mi as usize, mj as usize)
+            }))
+        }
     };
     let mut h = T::gather(std::array::from_fn(|l| &hist[ks[l]]));
     let c = model.force(&input, &pm, &mut h);
     let torque = if T::FRICTION { pair_torque(lever, &input, c.tangential.elastic + c.tangential.damping, ri, rj) } else { [Lanes::splat(0.0); 2] };
     let ratio = input.dn * gather(|l| pc[l].inv_r_min);
+    // The largest overlap so far: a lane beats it rarely, so one test per four pairs.
+    let beats = ratio.simd_gt(Lanes::splat(best.0)).bitmask();
+    if beats != 0 {
+        for (l, &k) in ks.iter().enumerate() {
+            if ratio.extract(l) > best.0 {
+                *best = (ratio.extract(l), k);
+            }
+        }
+    }
     // With the ledger, the energy terms too, in lanes; the ledger adds them later in
     // list order.
     let terms = if ENERGY {
@@ -337,7 +356,7 @@ struct Touch {
 /// A part of the pair list: the pairs, their constants, tangential states, energy
 /// memories (empty without the energy ledger) and touching flags.
 pub struct PairSlices<'a, T: Tangential> {
-    pub pairs: &'a [[u32; 2]],
+    pub pairs: CheckedPairs<'a>,
     pub consts: &'a [PairConst],
     pub hist: &'a mut [T::History<f64>],
     pub energy: &'a mut [EnergyMemory],
@@ -365,66 +384,78 @@ impl Ledgers<'_> {
 /// and are not any more, as indices into the part, in list order: the first `nt` of
 /// `touching` and the first `nr` of `released`, `(nt, nr)` returned; `sep[m]` is the
 /// separation (minimum image, i minus j) of pair `touching[m]`. `reach` holds each
-/// pair's `(r_i + r_j)^2` ([`crate::neighbor::PairList::reach`]). `skip` (if given)
-/// leaves out pairs computed elsewhere. No branch per pair, and the lists keep their
-/// length from step to step (no clearing).
+/// pair's `(r_i + r_j)^2` ([`crate::neighbor::PairList::reach`]). `skip` (indices into
+/// the part, ascending) leaves out pairs computed elsewhere: the stretches between them
+/// are swept one after the other, so that no pair pays for a test. No branch per pair,
+/// and the lists keep their length from step to step (no clearing).
 #[allow(clippy::too_many_arguments)]
-pub fn sort_pairs(x: &[Vec2], boundary: &Boundary, pairs: &[[u32; 2]], reach: &[f64], active: &[bool], skip: Option<&[u32]>, touching: &mut Vec<u32>, sep: &mut Vec<Vec2>, released: &mut Vec<u32>) -> (usize, usize) {
-    if touching.len() < pairs.len() {
-        touching.resize(pairs.len(), 0);
-        sep.resize(pairs.len(), Vec2::zeros());
-        released.resize(pairs.len(), 0);
+pub fn sort_pairs(x: &[Vec2], boundary: &Boundary, pairs: CheckedPairs<'_>, reach: &[f64], active: &[bool], skip: &[u32], touching: &mut Vec<u32>, sep: &mut Vec<Vec2>, released: &mut Vec<u32>) -> (usize, usize) {
+    let np = pairs.len();
+    if touching.len() < np {
+        touching.resize(np, 0);
+        sep.resize(np, Vec2::zeros());
+        released.resize(np, 0);
     }
-    match skip {
-        None => sweep(x, boundary, pairs, reach, active, |_| true, touching, sep, released),
-        Some(s) => sweep(x, boundary, pairs, reach, active, |k| s[k] == u32::MAX, touching, sep, released),
+    let (reach, active, touching, sep, released) = (&reach[..np], &active[..np], &mut touching[..np], &mut sep[..np], &mut released[..np]);
+    let (mut nt, mut nr, mut from) = (0, 0, 0);
+    for to in skip.iter().map(|&k| k as usize).chain(std::iter::once(np)) {
+        if to > from {
+            sweep(x, boundary, pairs, reach, active, from..to, touching, sep, released, &mut nt, &mut nr);
+        }
+        from = to + 1;
     }
+    (nt, nr)
 }
 
-/// The sweep of [`sort_pairs`]: four pairs' distances at a time in lanes, then their
-/// indices appended where they belong.
+/// The sweep of [`sort_pairs`] over the pairs `range` of the part: four pairs'
+/// distances at a time in lanes, then their indices appended where they belong (from
+/// `nt` and `nr` on, which it moves on). Every pair before the range is already sorted
+/// out or skipped, so `nt` and `nr` are at most its first index and every write is in
+/// bounds.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-fn sweep(x: &[Vec2], boundary: &Boundary, pairs: &[[u32; 2]], reach: &[f64], active: &[bool], mine: impl Fn(usize) -> bool, touching: &mut [u32], sep: &mut [Vec2], released: &mut [u32]) -> (usize, usize) {
-    // Cut to one length each: one bounds check per index.
-    let (np, n) = (pairs.len(), x.len());
-    let (reach, active, touching, sep, released, x) = (&reach[..np], &active[..np], &mut touching[..np], &mut sep[..np], &mut released[..np], &x[..n]);
-    let (mut nt, mut nr) = (0, 0);
-    let quads = pairs.len() / LANES * LANES;
-    for (q, (pq, rq)) in pairs[..quads].chunks_exact(LANES).zip(reach.chunks_exact(LANES)).enumerate() {
-        let d: Vector2<Lanes> = boundary.image(gather2(|l| x[pq[l][0] as usize] - x[pq[l][1] as usize]));
+fn sweep(x: &[Vec2], boundary: &Boundary, pairs: CheckedPairs<'_>, reach: &[f64], active: &[bool], range: std::ops::Range<usize>, touching: &mut [u32], sep: &mut [Vec2], released: &mut [u32], nt: &mut usize, nr: &mut usize) {
+    let xs = pairs.of(x);
+    let (mut t, mut r) = (*nt, *nr);
+    let quads = range.len() / LANES * LANES;
+    let k0 = range.start;
+    for (q, rq) in reach[range.clone()][..quads].chunks_exact(LANES).enumerate() {
+        let k = k0 + q * LANES;
+        let d: Vector2<Lanes> = boundary.image(gather2(|l| {
+            let (xi, xj) = xs.at(k + l);
+            xi - xj
+        }));
         let touch = d.norm_squared().simd_lt(gather(|l| rq[l])).bitmask();
-        let (mut was, mut own) = (0, 0);
+        let mut was = 0;
         for l in 0..LANES {
-            let k = q * LANES + l;
-            was |= (active[k] as u64) << l;
-            own |= (mine(k) as u64) << l;
+            was |= (active[k + l] as u64) << l;
         }
         // Touching: every index written, the count moved on where it touches.
         for l in 0..LANES {
-            touching[nt] = (q * LANES + l) as u32;
-            sep[nt] = lane2(&d, l);
-            nt += (touch & own) as usize >> l & 1;
+            touching[t] = (k + l) as u32;
+            sep[t] = lane2(&d, l);
+            t += touch as usize >> l & 1;
         }
         // Released: a few per step, so a branch that is almost never taken.
-        let gone = !touch & was & own;
+        let gone = !touch & was;
         if gone != 0 {
             for l in 0..LANES {
-                released[nr] = (q * LANES + l) as u32;
-                nr += gone as usize >> l & 1;
+                released[r] = (k + l) as u32;
+                r += gone as usize >> l & 1;
             }
         }
     }
-    for k in quads..pairs.len() {
-        let d = boundary.image(x[pairs[k][0] as usize] - x[pairs[k][1] as usize]);
-        let (touch, mine) = (d.norm_squared() < reach[k], mine(k));
-        touching[nt] = k as u32;
-        sep[nt] = d;
-        released[nr] = k as u32;
-        nt += (touch & mine) as usize;
-        nr += (!touch & active[k] & mine) as usize;
+    for k in k0 + quads..range.end {
+        let (xi, xj) = xs.at(k);
+        let d = boundary.image(xi - xj);
+        let touch = d.norm_squared() < reach[k];
+        touching[t] = k as u32;
+        sep[t] = d;
+        released[r] = k as u32;
+        t += touch as usize;
+        r += (!touch & active[k]) as usize;
     }
-    (nt, nr)
+    (*nt, *nr) = (t, r);
 }
 
 /// Compute the pairs `touching` and `released` of a list part (indices from
@@ -432,7 +463,9 @@ fn sweep(x: &[Vec2], boundary: &Boundary, pairs: &[[u32; 2]], reach: &[f64], act
 /// part, its grains and its output), in list order. The touching pairs run four at a
 /// time in SIMD lanes, their energy terms too (with the energy ledger); the ledger then
 /// adds those and the released pairs' in list order, so that it sums in the serial
-/// order; `pending` holds the terms meanwhile.
+/// order; `pending` holds the terms meanwhile. Returns the largest overlap over the
+/// smaller radius of the touching pairs and the index (in the part) of the first pair
+/// that has it, `(0, usize::MAX)` if none touches.
 #[allow(clippy::too_many_arguments)]
 pub fn compute_pairs<Dm: Damping, T: Tangential, const ENERGY: bool>(
     w: &PairView<'_, ContactModel<Dm, T>>,
@@ -443,7 +476,8 @@ pub fn compute_pairs<Dm: Damping, T: Tangential, const ENERGY: bool>(
     mut ledgers: Ledgers<'_>,
     mut sink: impl FnMut(usize, (usize, usize), PairOut),
     pending: &mut Vec<EnergyTerms>,
-) {
+) -> (f64, usize) {
+    let mut best = (0.0, usize::MAX);
     if ENERGY && pending.len() < touching.len() {
         pending.resize(touching.len(), EnergyTerms::default());
     }
@@ -454,12 +488,15 @@ pub fn compute_pairs<Dm: Damping, T: Tangential, const ENERGY: bool>(
     let mut pend = pending.chunks_exact_mut(LANES);
     for (ks, ds) in touching[..quads].chunks_exact(LANES).zip(sep.chunks_exact(LANES)) {
         let slices = PairSlices::<T> { pairs, consts, hist: &mut *hist, energy: &mut *energy, active: &mut *active };
-        four_pairs::<Dm, T, ENERGY>(w, slices, single.as_ref(), ks, ds, &mut sink, if ENERGY { pend.next().expect("a slot per pair") } else { &mut [] });
+        four_pairs::<Dm, T, ENERGY>(w, slices, single.as_ref(), ks, ds, &mut sink, if ENERGY { pend.next().expect("a slot per pair") } else { &mut [] }, &mut best);
     }
     for (m, &k) in touching.iter().enumerate().skip(quads) {
         let k = k as usize;
-        let (i, j) = (pairs[k][0] as usize, pairs[k][1] as usize);
+        let [i, j] = pairs.pairs()[k].map(|g| g as usize);
         let (o, p) = one_pair(w, (i, j), sep[m], &consts[k], &mut hist[k], &mut active[k]);
+        if o.ratio > best.0 {
+            best = (o.ratio, k);
+        }
         sink(k, (i, j), o);
         if ENERGY {
             pending[m] = w.law.energy_terms(p.n, p.dn, w.dt, &p.state, &mut energy[k]);
@@ -469,9 +506,9 @@ pub fn compute_pairs<Dm: Damping, T: Tangential, const ENERGY: bool>(
     if !ENERGY {
         for &k in released {
             let k = k as usize;
-            pair_contact::<Dm, T, false>(w, pairs[k], &consts[k], &mut hist[k], &mut EnergyMemory::default(), &mut active[k], &mut none);
+            pair_contact::<Dm, T, false>(w, pairs.pairs()[k], &consts[k], &mut hist[k], &mut EnergyMemory::default(), &mut active[k], &mut none);
         }
-        return;
+        return best;
     }
     // Both kinds merged in list order: the ledger is a sum.
     let (mut a, mut b) = (0, 0);
@@ -482,10 +519,11 @@ pub fn compute_pairs<Dm: Damping, T: Tangential, const ENERGY: bool>(
             a += 1;
         } else {
             let k = released[b] as usize;
-            pair_contact::<Dm, T, true>(w, pairs[k], &consts[k], &mut hist[k], &mut energy[k], &mut active[k], ledgers.get(k));
+            pair_contact::<Dm, T, true>(w, pairs.pairs()[k], &consts[k], &mut hist[k], &mut energy[k], &mut active[k], ledgers.get(k));
             b += 1;
         }
     }
+    best
 }
 
 /// What the pair kernel reads: everything but the forces it produces.
@@ -517,8 +555,8 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
         let mut worst = w.max_overlap;
         let mut f = std::mem::take(&mut w.p.f);
         let mut torque = std::mem::take(&mut w.p.torque);
-        let (pairs, consts) = (&w.pairs.pairs, &w.pairs.consts);
-        let (nt, nr) = sort_pairs(&w.p.x, &w.boundary, pairs, &w.pairs.reach, &w.pairs.active, None, &mut self.touching, &mut self.sep, &mut self.released);
+        let (pairs, consts) = (w.pairs.pairs.checked(), &w.pairs.consts);
+        let (nt, nr) = sort_pairs(&w.p.x, &w.boundary, pairs, &w.pairs.reach, &w.pairs.active, &[], &mut self.touching, &mut self.sep, &mut self.released);
         let (touching, sep, released) = (&self.touching[..nt], &self.sep[..nt], &self.released[..nr]);
         let view = PairView { p: &w.p, boundary: w.boundary, law: w.law, pair_table: &w.pair_table, dt: w.dt };
         let list = PairSlices::<T> { pairs, consts, hist: &mut w.pairs.hist, energy: &mut w.pairs.energy, active: &mut w.pairs.active };
@@ -532,11 +570,12 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
                 ts[i] -= o.torque[0];
                 ts[j] -= o.torque[1];
             }
-            if o.ratio > worst.0 {
-                worst = (o.ratio, i, j);
-            }
         };
-        compute_pairs::<Dm, T, ENERGY>(&view, list, touching, sep, released, Ledgers::One(&mut w.ledger), sink, &mut self.pending);
+        let (ratio, k) = compute_pairs::<Dm, T, ENERGY>(&view, list, touching, sep, released, Ledgers::One(&mut w.ledger), sink, &mut self.pending);
+        if ratio > worst.0 {
+            let [i, j] = pairs.pairs()[k];
+            worst = (ratio, i as usize, j as usize);
+        }
         w.p.f = f;
         w.p.torque = torque;
         w.max_overlap = worst;
