@@ -390,4 +390,18 @@ mod tests {
         assert_eq!(kept, vec![10.0, 0.0, 0.0, 30.0]);
         assert_eq!(list.touching(), 2);
     }
+
+    #[test]
+    fn checked_pairs_read_grain_values_and_refuse_short_arrays() {
+        let mut list: PairList<f64> = PairList::default();
+        let (r, m) = (vec![1.0; 6], vec![1.0; 6]);
+        list.replace(vec![[0, 4], [1, 2], [2, 3]], &r, &m);
+        let values = [10.0, 11.0, 12.0, 13.0, 14.0, 15.0];
+        let checked = list.pairs.checked();
+        assert_eq!(checked.of(&values).at(0), (10.0, 14.0));
+        assert_eq!(checked.part(1..3).of(&values).at(1), (12.0, 13.0));
+        // Grain 4 is listed: an array of four grains must be refused, not read past.
+        let short = std::panic::catch_unwind(|| checked.of(&values[..4]).at(0));
+        assert!(short.is_err());
+    }
 }

@@ -259,8 +259,8 @@ fn four_pairs<Dm: Damping, T: Tangential, const ENERGY: bool>(
 ) {
     let (model, p) = (w.law, w.p);
     let lever = model.options.lever_arm;
-    // The per-pair and per-grain slices cut to one length each, so that one bounds check
-    // per index serves every array it reads.
+    // The per-pair slices cut to one length, so that one bounds check per index serves
+    // them all; the per-grain arrays are read through the checked list, with none.
     let np = list.pairs.len();
     let (pairs, consts, hist, active) = (list.pairs.pairs(), &list.consts[..np], &mut list.hist[..np], &mut list.active[..np]);
     let (v, r, omega) = (list.pairs.of(&p.v), list.pairs.of(&p.r), list.pairs.of(&p.omega));
@@ -702,5 +702,49 @@ impl<L: ContactLaw> Stage<L> for Watchdog {
             w.check_finite()?;
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::neighbor::{PairList, brute_force_pairs};
+    use rand::{Rng, SeedableRng};
+
+    /// The sweep with pairs to skip gives what it gives without, less those pairs: the
+    /// stretches between skipped pairs (any length, so with and without a scalar tail)
+    /// are swept as the whole list is.
+    #[test]
+    fn skipped_pairs_leave_the_rest_of_the_sweep_unchanged() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+        let n = 300;
+        let boundary = Boundary::periodic_x(0.0, 1.0);
+        let x: Vec<Vec2> = (0..n).map(|_| Vec2::new(rng.random::<f64>(), 0.3 * rng.random::<f64>())).collect();
+        let r: Vec<f64> = (0..n).map(|_| 0.01 + 0.01 * rng.random::<f64>()).collect();
+        let mut list: PairList<f64> = PairList::default();
+        list.replace(brute_force_pairs(&x, &r, n, &boundary, 0.01), &r, &vec![1.0; n]);
+        let np = list.pairs.len();
+        assert!(np > 100, "{np} pairs");
+        let active: Vec<bool> = (0..np).map(|_| rng.random::<bool>()).collect();
+        let skip: Vec<u32> = (0..np as u32).filter(|_| rng.random::<f64>() < 0.1).chain([0, np as u32 - 1]).collect::<std::collections::BTreeSet<_>>().into_iter().collect();
+        let sweep = |skip: &[u32]| {
+            let (mut t, mut s, mut rel) = (Vec::new(), Vec::new(), Vec::new());
+            let (nt, nr) = sort_pairs(&x, &boundary, list.pairs.checked(), &list.reach, &active, skip, &mut t, &mut s, &mut rel);
+            (t[..nt].to_vec(), s[..nt].to_vec(), rel[..nr].to_vec())
+        };
+        let (all_t, all_s, all_r) = sweep(&[]);
+        let (t, s, rel) = sweep(&skip);
+        assert!(!all_t.is_empty() && !all_r.is_empty());
+        let kept = |k: &u32| skip.binary_search(k).is_err();
+        let want: Vec<(u32, Vec2)> = all_t.iter().zip(&all_s).filter(|(k, _)| kept(k)).map(|(&k, &d)| (k, d)).collect();
+        assert_eq!(t.iter().copied().zip(s).collect::<Vec<_>>(), want);
+        assert_eq!(rel, all_r.into_iter().filter(|k| kept(k)).collect::<Vec<_>>());
+        // Against the definition: touching when closer than r_i + r_j, released when
+        // not touching but active.
+        for k in 0..np {
+            let [i, j] = list.pairs[k].map(|g| g as usize);
+            let touch = boundary.image(x[i] - x[j]).norm() < r[i] + r[j];
+            assert_eq!(all_t.contains(&(k as u32)), touch, "pair {k}");
+        }
     }
 }
