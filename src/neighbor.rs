@@ -157,9 +157,19 @@ impl<T: Copy> GrainValues<'_, T> {
     /// The values of the two grains of pair `k`.
     #[inline(always)]
     pub fn at(self, k: usize) -> (T, T) {
-        let [i, j] = self.pairs[k];
-        // SAFETY: every grain index of the list is below `top` (PairList::replace), and
-        // `a` is at least `top` long (CheckedPairs::of).
+        self.of_pair(self.pairs[k])
+    }
+    /// The values of the two grains of each of the four pairs from `k` on (one bounds
+    /// check for the four).
+    #[inline(always)]
+    pub fn four(self, k: usize) -> [(T, T); 4] {
+        let q: &[[u32; 2]; 4] = self.pairs[k..k + 4].try_into().expect("four pairs");
+        std::array::from_fn(|l| self.of_pair(q[l]))
+    }
+    #[inline(always)]
+    fn of_pair(self, [i, j]: [u32; 2]) -> (T, T) {
+        // SAFETY: the pair is one of the list's, whose grain indices are all below `top`
+        // (PairList::replace), and `a` is at least `top` long (CheckedPairs::of).
         unsafe { (*self.a.get_unchecked(i as usize), *self.a.get_unchecked(j as usize)) }
     }
 }

@@ -417,23 +417,29 @@ pub fn sort_pairs(x: &[Vec2], boundary: &Boundary, pairs: CheckedPairs<'_>, reac
 fn sweep(x: &[Vec2], boundary: &Boundary, pairs: CheckedPairs<'_>, reach: &[f64], active: &[bool], range: std::ops::Range<usize>, touching: &mut [u32], sep: &mut [Vec2], released: &mut [u32], nt: &mut usize, nr: &mut usize) {
     let xs = pairs.of(x);
     let (mut t, mut r) = (*nt, *nr);
+    // Every index written below is at most the index of the pair being sorted out
+    // (`t` and `r` count a part of the pairs before it), so these checks cover them all.
+    assert!(t <= range.start && r <= range.start && range.end <= touching.len().min(sep.len()).min(released.len()));
     let quads = range.len() / LANES * LANES;
     let k0 = range.start;
-    for (q, rq) in reach[range.clone()][..quads].chunks_exact(LANES).enumerate() {
+    let (reach, active) = (&reach[range.clone()], &active[range.clone()]);
+    for (q, (rq, aq)) in reach[..quads].chunks_exact(LANES).zip(active[..quads].chunks_exact(LANES)).enumerate() {
         let k = k0 + q * LANES;
-        let d: Vector2<Lanes> = boundary.image(gather2(|l| {
-            let (xi, xj) = xs.at(k + l);
-            xi - xj
-        }));
+        let g = xs.four(k);
+        let d: Vector2<Lanes> = boundary.image(gather2(|l| g[l].0 - g[l].1));
         let touch = d.norm_squared().simd_lt(gather(|l| rq[l])).bitmask();
         let mut was = 0;
-        for l in 0..LANES {
-            was |= (active[k + l] as u64) << l;
+        for (l, &a) in aq.iter().enumerate() {
+            was |= (a as u64) << l;
         }
         // Touching: every index written, the count moved on where it touches.
         for l in 0..LANES {
-            touching[t] = (k + l) as u32;
-            sep[t] = lane2(&d, l);
+            debug_assert!(t <= k + l);
+            // SAFETY: t <= k + l < range.end <= touching.len(), sep.len() (asserted above).
+            unsafe {
+                *touching.get_unchecked_mut(t) = (k + l) as u32;
+                *sep.get_unchecked_mut(t) = lane2(&d, l);
+            }
             t += touch as usize >> l & 1;
         }
         // Released: a few per step, so a branch that is almost never taken.
@@ -445,15 +451,16 @@ fn sweep(x: &[Vec2], boundary: &Boundary, pairs: CheckedPairs<'_>, reach: &[f64]
             }
         }
     }
-    for k in k0 + quads..range.end {
+    for m in quads..range.len() {
+        let k = k0 + m;
         let (xi, xj) = xs.at(k);
         let d = boundary.image(xi - xj);
-        let touch = d.norm_squared() < reach[k];
+        let touch = d.norm_squared() < reach[m];
         touching[t] = k as u32;
         sep[t] = d;
         released[r] = k as u32;
         t += touch as usize;
-        r += (!touch & active[k]) as usize;
+        r += (!touch & active[m]) as usize;
     }
     (*nt, *nr) = (t, r);
 }
