@@ -428,10 +428,9 @@ fn sweep(x: &[Vec2], boundary: &Boundary, pairs: CheckedPairs<'_>, reach: &[f64]
         let g = xs.four(k);
         let d: Vector2<Lanes> = boundary.image(gather2(|l| g[l].0 - g[l].1));
         let touch = d.norm_squared().simd_lt(gather(|l| rq[l])).bitmask();
-        let mut was = 0;
-        for (l, &a) in aq.iter().enumerate() {
-            was |= (a as u64) << l;
-        }
+        // The four flags (bytes 0 or 1) as the low four bits: one load, one multiply
+        // (the shifted copies of the bytes land on bits 24..27 without carries).
+        let was = (u32::from_le_bytes([aq[0] as u8, aq[1] as u8, aq[2] as u8, aq[3] as u8]).wrapping_mul(0x0102_0408) >> 24 & 0xf) as u64;
         // Touching: every index written, the count moved on where it touches.
         for l in 0..LANES {
             debug_assert!(t <= k + l);
@@ -740,18 +739,20 @@ mod tests {
             (t[..nt].to_vec(), s[..nt].to_vec(), rel[..nr].to_vec())
         };
         let (all_t, all_s, all_r) = sweep(&[]);
+        let all_r_copy = all_r.clone();
         let (t, s, rel) = sweep(&skip);
         assert!(!all_t.is_empty() && !all_r.is_empty());
         let kept = |k: &u32| skip.binary_search(k).is_err();
         let want: Vec<(u32, Vec2)> = all_t.iter().zip(&all_s).filter(|(k, _)| kept(k)).map(|(&k, &d)| (k, d)).collect();
         assert_eq!(t.iter().copied().zip(s).collect::<Vec<_>>(), want);
-        assert_eq!(rel, all_r.into_iter().filter(|k| kept(k)).collect::<Vec<_>>());
+        assert_eq!(rel, all_r_copy.into_iter().filter(|k| kept(k)).collect::<Vec<_>>());
         // Against the definition: touching when closer than r_i + r_j, released when
         // not touching but active.
         for k in 0..np {
             let [i, j] = list.pairs[k].map(|g| g as usize);
             let touch = boundary.image(x[i] - x[j]).norm() < r[i] + r[j];
             assert_eq!(all_t.contains(&(k as u32)), touch, "pair {k}");
+            assert_eq!(all_r.contains(&(k as u32)), !touch && active[k], "pair {k}");
         }
     }
 }
