@@ -49,8 +49,6 @@ pub struct ParallelPairForces<const ENERGY: bool> {
     /// and the same as indices into their range's part of the list.
     cross: Vec<u32>,
     cross_in_part: Vec<u32>,
-    /// Length of the list the tables were made for.
-    listed: usize,
     /// Slot bounds of each range's cross pairs (those whose first grain it owns).
     cross_bounds: Vec<usize>,
     cross_out: Vec<PairOut>,
@@ -89,7 +87,6 @@ impl<const ENERGY: bool> ParallelPairForces<ENERGY> {
             pair_bounds: Vec::new(),
             cross: Vec::new(),
             cross_in_part: Vec::new(),
-            listed: 0,
             cross_bounds: Vec::new(),
             cross_out: Vec::new(),
             incoming: Vec::new(),
@@ -141,7 +138,6 @@ impl<const ENERGY: bool> ParallelPairForces<ENERGY> {
         }
         self.cross_out.clear();
         self.cross_out.resize(self.cross.len(), PairOut::default());
-        self.listed = pairs.len();
     }
 }
 
@@ -152,7 +148,7 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
     fn run(&mut self, w: &mut World<ContactModel<Dm, T>>) -> Result<(), Error> {
         let n = w.p.len();
         let np = w.pairs.pairs.len();
-        if self.built_for != w.neighbours.builds || self.listed != np || *self.bounds.last().unwrap_or(&usize::MAX) != n {
+        if self.built_for != w.neighbours.builds || self.pair_bounds.last() != Some(&np) || *self.bounds.last().unwrap_or(&usize::MAX) != n {
             self.tables(n, &w.pairs.pairs);
             self.built_for = w.neighbours.builds;
         }

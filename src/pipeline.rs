@@ -271,8 +271,14 @@ fn four_pairs<Dm: Damping, T: Tangential, const ENERGY: bool>(
     });
     let pc: [&PairConst; LANES] = std::array::from_fn(|l| &consts[ks[l]]);
     let d = gather2(|l| ds[l]);
-    let (ri, rj) = (gather(|l| r.at(ks[l]).0), gather(|l| r.at(ks[l]).1));
-    let (wi, wj) = if T::FRICTION { (gather(|l| omega.at(ks[l]).0), gather(|l| omega.at(ks[l]).1)) } else { (Lanes::splat(0.0), Lanes::splat(0.0)) };
+    let rs: [(f64, f64); LANES] = std::array::from_fn(|l| r.at(ks[l]));
+    let (ri, rj) = (gather(|l| rs[l].0), gather(|l| rs[l].1));
+    let (wi, wj) = if T::FRICTION {
+        let ws: [(f64, f64); LANES] = std::array::from_fn(|l| omega.at(ks[l]));
+        (gather(|l| ws[l].0), gather(|l| ws[l].1))
+    } else {
+        (Lanes::splat(0.0), Lanes::splat(0.0))
+    };
     let v_rel = gather2(|l| {
         let (vi, vj) = v.at(ks[l]);
         vi - vj
@@ -739,20 +745,19 @@ mod tests {
             (t[..nt].to_vec(), s[..nt].to_vec(), rel[..nr].to_vec())
         };
         let (all_t, all_s, all_r) = sweep(&[]);
-        let all_r_copy = all_r.clone();
         let (t, s, rel) = sweep(&skip);
         assert!(!all_t.is_empty() && !all_r.is_empty());
         let kept = |k: &u32| skip.binary_search(k).is_err();
         let want: Vec<(u32, Vec2)> = all_t.iter().zip(&all_s).filter(|(k, _)| kept(k)).map(|(&k, &d)| (k, d)).collect();
         assert_eq!(t.iter().copied().zip(s).collect::<Vec<_>>(), want);
-        assert_eq!(rel, all_r_copy.into_iter().filter(|k| kept(k)).collect::<Vec<_>>());
+        assert_eq!(rel, all_r.iter().copied().filter(|k| kept(k)).collect::<Vec<_>>());
         // Against the definition: touching when closer than r_i + r_j, released when
         // not touching but active.
-        for k in 0..np {
-            let [i, j] = list.pairs[k].map(|g| g as usize);
+        for (k, (p, &was)) in list.pairs.iter().zip(&active).enumerate() {
+            let [i, j] = p.map(|g| g as usize);
             let touch = boundary.image(x[i] - x[j]).norm() < r[i] + r[j];
             assert_eq!(all_t.contains(&(k as u32)), touch, "pair {k}");
-            assert_eq!(all_r.contains(&(k as u32)), !touch && active[k], "pair {k}");
+            assert_eq!(all_r.contains(&(k as u32)), !touch && was, "pair {k}");
         }
     }
 }
