@@ -24,6 +24,10 @@ impl Boundary {
     pub fn periodic_x(x_min: f64, length: f64) -> Self {
         Boundary { x_min, period: length, inv_period: 1.0 / length }
     }
+    /// 1 / period, 1/m (0 if not periodic).
+    pub fn inv_period(&self) -> f64 {
+        self.inv_period
+    }
     pub fn is_periodic(&self) -> bool {
         self.period > 0.0
     }
@@ -54,10 +58,15 @@ impl Boundary {
 /// the innermost loop). Exact for every finite `v`: from 2^51 on, `v` is an integer.
 #[inline(always)]
 pub fn nearest_integer<R: Real>(v: R) -> R {
-    // 1.5 * 2^52: adding it leaves no fractional bits, so the sum is rounded to an integer.
-    let shift = R::splat(6_755_399_441_055_744.0);
-    crate::lanes::pick(v.simd_abs().simd_lt(R::splat(2_251_799_813_685_248.0)), (v + shift) - shift, v)
+    let shift = R::splat(ROUND_SHIFT);
+    crate::lanes::pick(v.simd_abs().simd_lt(R::splat(ROUND_EXACT_FROM)), (v + shift) - shift, v)
 }
+
+/// 1.5 * 2^52: adding it to a number below 2^51 in magnitude leaves no fractional bits,
+/// so the sum is rounded to an integer ([`nearest_integer`]).
+pub const ROUND_SHIFT: f64 = 6_755_399_441_055_744.0;
+/// 2^51: from here on every `f64` is an integer ([`nearest_integer`] returns it as is).
+pub const ROUND_EXACT_FROM: f64 = 2_251_799_813_685_248.0;
 
 #[cfg(test)]
 mod tests {

@@ -166,6 +166,12 @@ impl<T: Copy> GrainValues<'_, T> {
         let q: &[[u32; 2]; 4] = self.pairs[k..k + 4].try_into().expect("four pairs");
         std::array::from_fn(|l| self.of_pair(q[l]))
     }
+    /// The start of the per-grain array: every grain index of the list's pairs is an
+    /// offset within it (for code that reads several grains with one instruction).
+    #[inline(always)]
+    pub fn as_ptr(self) -> *const T {
+        self.a.as_ptr()
+    }
     #[inline(always)]
     fn of_pair(self, [i, j]: [u32; 2]) -> (T, T) {
         // SAFETY: the pair is one of the list's, whose grain indices are all below `top`

@@ -396,6 +396,13 @@ impl Ledgers<'_> {
 /// and the lists keep their length from step to step (no clearing).
 #[allow(clippy::too_many_arguments)]
 pub fn sort_pairs(x: &[Vec2], boundary: &Boundary, pairs: CheckedPairs<'_>, reach: &[f64], active: &[bool], skip: &[u32], touching: &mut Vec<u32>, sep: &mut Vec<Vec2>, released: &mut Vec<u32>) -> (usize, usize) {
+    sort_pairs_with(true, x, boundary, pairs, reach, active, skip, touching, sep, released)
+}
+
+/// [`sort_pairs`], with the CPU-specific sweep (`wide`, where the build has one:
+/// [`crate::avx512`]) or the portable one alone (for the tests that compare them).
+#[allow(clippy::too_many_arguments)]
+fn sort_pairs_with(wide: bool, x: &[Vec2], boundary: &Boundary, pairs: CheckedPairs<'_>, reach: &[f64], active: &[bool], skip: &[u32], touching: &mut Vec<u32>, sep: &mut Vec<Vec2>, released: &mut Vec<u32>) -> (usize, usize) {
     let np = pairs.len();
     if touching.len() < np {
         touching.resize(np, 0);
@@ -406,6 +413,10 @@ pub fn sort_pairs(x: &[Vec2], boundary: &Boundary, pairs: CheckedPairs<'_>, reac
     let (mut nt, mut nr, mut from) = (0, 0, 0);
     for to in skip.iter().map(|&k| k as usize).chain(std::iter::once(np)) {
         if to > from {
+            #[cfg(all(target_arch = "x86_64", target_feature = "avx512f", target_feature = "avx512vl", target_feature = "avx512bw"))]
+            let from = if wide { crate::avx512::sweep_eights(x, boundary, pairs, reach, active, from..to, touching, sep, released, &mut nt, &mut nr) } else { from };
+            #[cfg(not(all(target_arch = "x86_64", target_feature = "avx512f", target_feature = "avx512vl", target_feature = "avx512bw")))]
+            let _ = wide;
             sweep(x, boundary, pairs, reach, active, from..to, touching, sep, released, &mut nt, &mut nr);
         }
         from = to + 1;
@@ -722,6 +733,38 @@ mod tests {
     use super::*;
     use crate::neighbor::{PairList, brute_force_pairs};
     use rand::{Rng, SeedableRng};
+
+    /// The AVX-512 sweep gives the portable sweep's lists and separations, bit for bit:
+    /// across the periodic seam and without periodicity, with pairs released, and for
+    /// stretches of every length between skipped pairs (so with every tail the eight-wide
+    /// loop leaves to the portable one).
+    #[cfg(all(target_arch = "x86_64", target_feature = "avx512f", target_feature = "avx512vl", target_feature = "avx512bw"))]
+    #[test]
+    fn avx512_sweep_gives_the_portable_bits() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
+        let n = 400;
+        for boundary in [Boundary::periodic_x(-0.5, 1.0), Boundary::open()] {
+            let x: Vec<Vec2> = (0..n).map(|_| Vec2::new(rng.random::<f64>() - 0.5, 0.3 * rng.random::<f64>())).collect();
+            let r: Vec<f64> = (0..n).map(|_| 0.01 + 0.01 * rng.random::<f64>()).collect();
+            let mut list: PairList<f64> = PairList::default();
+            list.replace(brute_force_pairs(&x, &r, n, &boundary, 0.01), &r, &vec![1.0; n]);
+            let np = list.pairs.len();
+            let seam = list.pairs.iter().filter(|p| (x[p[0] as usize].x - x[p[1] as usize].x).abs() > 0.5).count();
+            assert!(np > 200 && (seam > 5) == boundary.is_periodic(), "{np} pairs, {seam} across the seam");
+            let active: Vec<bool> = (0..np).map(|_| rng.random::<bool>()).collect();
+            for skip_rate in [0.0, 0.05, 0.3] {
+                let skip: Vec<u32> = (0..np as u32).filter(|_| rng.random::<f64>() < skip_rate).collect();
+                let sweep = |wide: bool| {
+                    let (mut t, mut s, mut rel) = (Vec::new(), Vec::new(), Vec::new());
+                    let (nt, nr) = sort_pairs_with(wide, &x, &boundary, list.pairs.checked(), &list.reach, &active, &skip, &mut t, &mut s, &mut rel);
+                    (t[..nt].to_vec(), s[..nt].iter().map(|d| [d.x.to_bits(), d.y.to_bits()]).collect::<Vec<_>>(), rel[..nr].to_vec())
+                };
+                let (wide, portable) = (sweep(true), sweep(false));
+                assert!(portable.0.len() > 20 && portable.2.len() > 20, "{} touching, {} released", portable.0.len(), portable.2.len());
+                assert_eq!(wide, portable, "skip rate {skip_rate}, periodic {}", boundary.is_periodic());
+            }
+        }
+    }
 
     /// The sweep with pairs to skip gives what it gives without, less those pairs: the
     /// stretches between skipped pairs (any length, so with and without a scalar tail)
