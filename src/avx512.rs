@@ -27,11 +27,13 @@ use crate::neighbor::CheckedPairs;
 pub const WIDTH: usize = 8;
 
 /// Sort out the pairs `range.start..range.start + 8 m` (the largest multiple of eight
-/// that fits in `range`) as the portable sweep does: touching pairs appended to
-/// `touching` (with their separations to `sep`) from `nt` on, released ones to
-/// `released` from `nr` on; `nt` and `nr` move on. Every pair before the range is sorted
-/// out or skipped already, so `nt` and `nr` are at most `range.start`. Returns the end of
-/// what it swept, for the portable sweep to take the rest.
+/// that fits in `range`) as the portable sweep does, leaving out those in `skip`
+/// (ascending, within the range): touching pairs appended to `touching` (with their
+/// separations to `sep`) from `nt` on, released ones to `released` from `nr` on; `nt`
+/// and `nr` move on. Every pair before the range is sorted out or skipped already, so
+/// `nt` and `nr` are at most `range.start`. Returns the end of what it swept, for the
+/// portable sweep to take the rest. Skipped pairs (the parallel stage's cross pairs) are
+/// masked lanes, not breaks in the sweep: the eight-wide blocks go on undisturbed.
 #[allow(clippy::too_many_arguments)]
 pub fn sweep_eights(
     x: &[Vec2],
@@ -39,6 +41,7 @@ pub fn sweep_eights(
     pairs: CheckedPairs<'_>,
     reach: &[f64],
     active: &[bool],
+    skip: &[u32],
     range: Range<usize>,
     touching: &mut [u32],
     sep: &mut [Vec2],
@@ -55,10 +58,11 @@ pub fn sweep_eights(
     let xs = pairs.of(x);
     assert!(end <= pairs.len() && end <= reach.len() && end <= active.len());
     assert!(t <= range.start && r <= range.start && end <= touching.len().min(sep.len()).min(released.len()));
+    assert!(skip.first().is_none_or(|&k| k as usize >= range.start) && skip.is_sorted());
     let list = pairs.pairs().as_ptr();
     // SAFETY: the build targets these features (the module is compiled only then), and
     // the pointers are good for the pairs before `end` (asserted above).
-    unsafe { eights(list, xs.as_ptr() as *const f64, boundary, reach.as_ptr(), active.as_ptr(), range.start..end, touching.as_mut_ptr(), sep.as_mut_ptr(), released.as_mut_ptr(), &mut t, &mut r) };
+    unsafe { eights(list, xs.as_ptr() as *const f64, boundary, reach.as_ptr(), active.as_ptr(), skip, range.start..end, touching.as_mut_ptr(), sep.as_mut_ptr(), released.as_mut_ptr(), &mut t, &mut r) };
     (*nt, *nr) = (t, r);
     end
 }
@@ -67,7 +71,7 @@ pub fn sweep_eights(
 /// pointers that are good for it.
 #[target_feature(enable = "avx512f,avx512vl,avx512bw")]
 #[allow(clippy::too_many_arguments)]
-unsafe fn eights(list: *const [u32; 2], xp: *const f64, boundary: &Boundary, reach: *const f64, active: *const bool, range: Range<usize>, touching: *mut u32, sep: *mut Vec2, released: *mut u32, t: &mut usize, r: &mut usize) {
+unsafe fn eights(list: *const [u32; 2], xp: *const f64, boundary: &Boundary, reach: *const f64, active: *const bool, skip: &[u32], range: Range<usize>, touching: *mut u32, sep: *mut Vec2, released: *mut u32, t: &mut usize, r: &mut usize) {
     let period = _mm512_set1_pd(boundary.period);
     let inv_period = _mm512_set1_pd(boundary.inv_period());
     let (shift, exact) = (_mm512_set1_pd(ROUND_SHIFT), _mm512_set1_pd(ROUND_EXACT_FROM));
@@ -75,7 +79,13 @@ unsafe fn eights(list: *const [u32; 2], xp: *const f64, boundary: &Boundary, rea
     // Separations from eight x and eight y values back to eight (x, y) pairs.
     let (first, second) = (_mm512_setr_epi64(0, 8, 1, 9, 2, 10, 3, 11), _mm512_setr_epi64(4, 12, 5, 13, 6, 14, 7, 15));
     let mut k = range.start;
+    let mut skip = skip.iter().map(|&k| k as usize).peekable();
     while k < range.end {
+        // The lanes to leave out: usually none (one compare).
+        let mut left_out = 0u8;
+        while let Some(m) = skip.next_if(|&m| m < k + WIDTH) {
+            left_out |= 1 << (m - k);
+        }
         // SAFETY: see the caller; a grain index doubled is a positive i32 offset
         // below 2^31 (2^30 grains would take 400 GB).
         unsafe {
@@ -91,7 +101,7 @@ unsafe fn eights(list: *const [u32; 2], xp: *const f64, boundary: &Boundary, rea
             let s = _mm512_mask_blend_pd(small, v, _mm512_sub_pd(_mm512_add_pd(v, shift), shift));
             let dx = _mm512_sub_pd(dx, _mm512_mul_pd(period, s));
             let d2 = _mm512_add_pd(_mm512_mul_pd(dx, dx), _mm512_mul_pd(dy, dy));
-            let touch = _mm512_cmp_pd_mask::<_CMP_LT_OQ>(d2, _mm512_loadu_pd(reach.add(k)));
+            let touch = _mm512_cmp_pd_mask::<_CMP_LT_OQ>(d2, _mm512_loadu_pd(reach.add(k))) & !left_out;
             let index = _mm256_add_epi32(_mm256_set1_epi32(k as i32), lane);
             _mm256_storeu_si256(touching.add(*t) as *mut __m256i, _mm256_maskz_compress_epi32(touch, index));
             let (cx, cy) = (_mm512_maskz_compress_pd(touch, dx), _mm512_maskz_compress_pd(touch, dy));
@@ -101,7 +111,7 @@ unsafe fn eights(list: *const [u32; 2], xp: *const f64, boundary: &Boundary, rea
             *t += touch.count_ones() as usize;
             // Released: touching before (flag bytes 0 or 1), not now. A few per step.
             let flags = _mm_loadl_epi64(active.add(k) as *const __m128i);
-            let gone = !touch & _mm_test_epi8_mask(flags, flags) as u8;
+            let gone = !(touch | left_out) & _mm_test_epi8_mask(flags, flags) as u8;
             if gone != 0 {
                 _mm256_storeu_si256(released.add(*r) as *mut __m256i, _mm256_maskz_compress_epi32(gone, index));
                 *r += gone.count_ones() as usize;

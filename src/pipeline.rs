@@ -391,9 +391,10 @@ impl Ledgers<'_> {
 /// `touching` and the first `nr` of `released`, `(nt, nr)` returned; `sep[m]` is the
 /// separation (minimum image, i minus j) of pair `touching[m]`. `reach` holds each
 /// pair's `(r_i + r_j)^2` ([`crate::neighbor::PairList::reach`]). `skip` (indices into
-/// the part, ascending) leaves out pairs computed elsewhere: the stretches between them
-/// are swept one after the other, so that no pair pays for a test. No branch per pair,
-/// and the lists keep their length from step to step (no clearing).
+/// the part, ascending) leaves out pairs computed elsewhere: the portable sweep sweeps
+/// the stretches between them one after the other, so that no pair pays for a test; the
+/// AVX-512 sweep masks their lanes. No branch per pair, and the lists keep their length
+/// from step to step (no clearing).
 #[allow(clippy::too_many_arguments)]
 pub fn sort_pairs(x: &[Vec2], boundary: &Boundary, pairs: CheckedPairs<'_>, reach: &[f64], active: &[bool], skip: &[u32], touching: &mut Vec<u32>, sep: &mut Vec<Vec2>, released: &mut Vec<u32>) -> (usize, usize) {
     sort_pairs_with(true, x, boundary, pairs, reach, active, skip, touching, sep, released)
@@ -411,12 +412,18 @@ fn sort_pairs_with(wide: bool, x: &[Vec2], boundary: &Boundary, pairs: CheckedPa
     }
     let (reach, active, touching, sep, released) = (&reach[..np], &active[..np], &mut touching[..np], &mut sep[..np], &mut released[..np]);
     let (mut nt, mut nr, mut from) = (0, 0, 0);
+    // Where the build has a CPU-specific sweep, it takes all but a short tail.
+    #[cfg(all(target_arch = "x86_64", target_feature = "avx512f", target_feature = "avx512vl", target_feature = "avx512bw"))]
+    let skip = if wide {
+        from = crate::avx512::sweep_eights(x, boundary, pairs, reach, active, skip, 0..np, touching, sep, released, &mut nt, &mut nr);
+        &skip[skip.partition_point(|&k| (k as usize) < from)..]
+    } else {
+        skip
+    };
+    #[cfg(not(all(target_arch = "x86_64", target_feature = "avx512f", target_feature = "avx512vl", target_feature = "avx512bw")))]
+    let _ = wide;
     for to in skip.iter().map(|&k| k as usize).chain(std::iter::once(np)) {
         if to > from {
-            #[cfg(all(target_arch = "x86_64", target_feature = "avx512f", target_feature = "avx512vl", target_feature = "avx512bw"))]
-            let from = if wide { crate::avx512::sweep_eights(x, boundary, pairs, reach, active, from..to, touching, sep, released, &mut nt, &mut nr) } else { from };
-            #[cfg(not(all(target_arch = "x86_64", target_feature = "avx512f", target_feature = "avx512vl", target_feature = "avx512bw")))]
-            let _ = wide;
             sweep(x, boundary, pairs, reach, active, from..to, touching, sep, released, &mut nt, &mut nr);
         }
         from = to + 1;
