@@ -5,18 +5,21 @@
 //! serial loop adds to a grain g first its pairs (m, g), m < g, in list order, then its
 //! pairs (g, j). The grains (stored along a Z curve, so index ranges are compact in space)
 //! are split into one index range per thread, balanced by the pairs' expected cost
-//! (listed pairs, the touching ones weighted: [`TOUCHING_COST`]); the pairs whose
+//! (listed pairs, the touching ones and the cross pairs below weighted: [`TOUCHING_COST`],
+//! [`CROSS_COST`]); the pairs whose
 //! first grain is in a range are a contiguous part of the list, with their histories.
-//! (1) The few pairs that join two ranges ("cross" pairs; nearly all are free grains of
-//! the first range against the rough walls' grains, last in the index space) are
-//! computed, shared evenly between the threads. (2) Each thread adds to its grains the
-//! cross pairs that come from earlier ranges (they are first in every grain's sequence),
-//! then runs the serial stage's two passes over the rest of its part (sort out the
-//! touching pairs, compute them four at a time, adding each result as it comes, in list
-//! order), then adds its own cross pairs: a grain's pairs (g, j) with j in a later range
-//! have the largest j, so they are the last of its sequence. (3) The energy terms are
-//! merged in list order and the largest overlap picked as the serial
-//! loop would. `tests/parallel.rs` checks identical bits with 1 and 2 threads.
+//! The pairs that join two ranges ("cross" pairs; nearly all are free grains of the first
+//! range against the rough walls' grains, last in the index space) belong to the thread
+//! of their first grain. In one hand-over per step, each thread (1) computes its cross
+//! pairs and publishes what they did, (2) sorts out the touching pairs of the rest of its
+//! part, (3) adds to its grains the cross pairs from earlier ranges (they are first in
+//! every grain's sequence; it waits for their threads to publish, which they do first
+//! thing), (4) computes its touching pairs four at a time, adding each result as it
+//! comes, in list order, and (5) adds its own cross pairs to their first grains: a
+//! grain's pairs (g, j) with j in a later range have the largest j, so they are the last
+//! of its sequence. Then the energy terms are merged in list order and the largest
+//! overlap picked as the serial loop would. `tests/parallel.rs` checks identical bits
+//! with 1 and 2 threads.
 
 use crate::contact::ContactModel;
 use crate::contact::damping::Damping;
@@ -26,6 +29,8 @@ use crate::observe::energy::EnergyLedger;
 use crate::pipeline::{Ledgers, PairOut, PairSlices, PairView, Stage, compute_pairs, sort_pairs};
 use crate::sim::World;
 use crate::threads::Threads;
+use crate::dim::Vec2;
+use std::sync::OnceLock;
 
 /// What a touching pair costs the contact stage, in listed pairs: each listed pair is
 /// swept, each touching one also goes through the kernel. At 5000 grains on one thread
@@ -35,15 +40,48 @@ use crate::threads::Threads;
 /// this weight (touching counted at the list's build) both took the same time within 2%.
 const TOUCHING_COST: usize = 8;
 
+/// What a cross pair costs its thread on top of an own pair, in listed pairs. The thread
+/// owning its first grain sorts it out and computes it before its own pairs, one by one
+/// and scattered through the list: 12-20 ns per cross pair at 20 000-100 000 grains
+/// (timed per thread), against about 5 ns for a listed pair in the sweep and kernel.
+const CROSS_COST: usize = 10;
+
 /// One thread's working lists.
 #[derive(Default)]
 struct Scratch {
     touching: Vec<u32>,
-    sep: Vec<crate::dim::Vec2>,
+    sep: Vec<Vec2>,
     released: Vec<u32>,
     pending: Vec<crate::contact::EnergyTerms>,
     /// Largest overlap ratio of the part and its pair index.
     worst: (f64, usize),
+    /// What the thread's cross pairs did this step, in slot order.
+    cross_out: Vec<PairOut>,
+}
+
+/// Publishes an empty result if the thread unwinds before it publishes its own.
+struct Publish<'a, 'b>(&'a OnceLock<&'b [PairOut]>);
+
+impl Drop for Publish<'_, '_> {
+    fn drop(&mut self) {
+        let _ = self.0.set(&[]);
+    }
+}
+
+/// What another thread published, once it has (it does so early in its step).
+fn wait<'b>(cell: &OnceLock<&'b [PairOut]>) -> &'b [PairOut] {
+    let mut spins = 0u32;
+    loop {
+        if let Some(v) = cell.get() {
+            return v;
+        }
+        spins += 1;
+        if spins < 1 << 12 {
+            std::hint::spin_loop();
+        } else {
+            std::thread::yield_now();
+        }
+    }
 }
 
 /// Grain-grain contacts on the run's thread pool.
@@ -59,7 +97,6 @@ pub struct ParallelPairForces<const ENERGY: bool> {
     cross_in_part: Vec<u32>,
     /// Slot bounds of each range's cross pairs (those whose first grain it owns).
     cross_bounds: Vec<usize>,
-    cross_out: Vec<PairOut>,
     /// For each range, the slots of the cross pairs whose second grain is in it, in list order.
     incoming: Vec<Vec<u32>>,
     /// Energy terms of every pair, merged in list order (with the energy ledger only).
@@ -87,27 +124,52 @@ fn cut<'a, T>(mut v: &'a mut [T], bounds: &[usize]) -> Vec<&'a mut [T]> {
 }
 
 /// The listed pairs `slots` (list indices, ascending, all in the list part from `k0`)
-/// sorted out into `sc` as [`sort_pairs`] sorts out a stretch of the list: touching
-/// (with separations) and released, as indices into the part; `(nt, nr)` returned.
-fn sort_listed<L: crate::contact::ContactLaw>(view: &PairView<'_, L>, pairs: &[[u32; 2]], reach: &[f64], active: &[bool], k0: usize, slots: &[u32], sc: &mut Scratch) -> (usize, usize) {
+/// sorted out as [`sort_pairs`] sorts out a stretch of the list: the first `nt` of
+/// `touching` (with their separations in `sep`) and the first `nr` of `released`, as
+/// indices into the part; `(nt, nr)` returned.
+#[allow(clippy::too_many_arguments)]
+fn sort_listed<L: crate::contact::ContactLaw>(view: &PairView<'_, L>, pairs: &[[u32; 2]], reach: &[f64], active: &[bool], k0: usize, slots: &[u32], touching: &mut Vec<u32>, sep: &mut Vec<Vec2>, released: &mut Vec<u32>) -> (usize, usize) {
     let (x, b) = (&view.p.x, view.boundary);
     let (mut nt, mut nr) = (0, 0);
-    sc.touching.resize(sc.touching.len().max(slots.len()), 0);
-    sc.sep.resize(sc.touching.len(), crate::dim::Vec2::zeros());
-    sc.released.resize(sc.touching.len(), 0);
+    let len = touching.len().max(slots.len());
+    touching.resize(len, 0);
+    sep.resize(len, Vec2::zeros());
+    released.resize(len, 0);
     for &k in slots {
         let k = k as usize;
         let [i, j] = pairs[k].map(|g| g as usize);
         let d = b.image(x[i] - x[j]);
         if d.norm_squared() < reach[k] {
-            (sc.touching[nt], sc.sep[nt]) = ((k - k0) as u32, d);
+            (touching[nt], sep[nt]) = ((k - k0) as u32, d);
             nt += 1;
         } else if active[k - k0] {
-            sc.released[nr] = (k - k0) as u32;
+            released[nr] = (k - k0) as u32;
             nr += 1;
         }
     }
     (nt, nr)
+}
+
+/// The range of grain `g` for range bounds `b`.
+fn range_of(g: usize, b: &[usize]) -> usize {
+    b.partition_point(|&x| x <= g) - 1
+}
+
+/// Bounds of `t` grain ranges of about equal total cost (`cost` per grain).
+fn balanced(cost: &[usize], t: usize) -> Vec<usize> {
+    let n = cost.len();
+    let mut cumulative = vec![0usize; n + 1];
+    for g in 0..n {
+        cumulative[g + 1] = cumulative[g] + cost[g];
+    }
+    let mut bounds = vec![0];
+    for r in 1..t {
+        let target = cumulative[n] * r / t;
+        let g = cumulative.partition_point(|&c| c < target).min(n);
+        bounds.push(g.max(*bounds.last().unwrap()));
+    }
+    bounds.push(n);
+    bounds
 }
 
 impl<const ENERGY: bool> ParallelPairForces<ENERGY> {
@@ -120,7 +182,6 @@ impl<const ENERGY: bool> ParallelPairForces<ENERGY> {
             cross: Vec::new(),
             cross_in_part: Vec::new(),
             cross_bounds: Vec::new(),
-            cross_out: Vec::new(),
             incoming: Vec::new(),
             ledgers: Vec::new(),
             scratch: (0..t).map(|_| Scratch::default()).collect(),
@@ -131,31 +192,30 @@ impl<const ENERGY: bool> ParallelPairForces<ENERGY> {
     /// The ranges and the cross pairs for a new list (`active`: which of its pairs touched
     /// at the last step).
     fn tables(&mut self, n: usize, pairs: &[[u32; 2]], active: &[bool]) {
-        // Per grain (cumulative): the pairs it is first in, and their expected cost.
-        let (mut first, mut cost) = (vec![0usize; n + 1], vec![0usize; n + 1]);
+        // Per grain: the pairs it is first in (cumulative), and their expected cost.
+        let (mut first, mut cost) = (vec![0usize; n + 1], vec![0usize; n]);
         for (p, &a) in pairs.iter().zip(active) {
             debug_assert!(p[0] < p[1]);
             first[p[0] as usize + 1] += 1;
-            cost[p[0] as usize + 1] += 1 + TOUCHING_COST * a as usize;
+            cost[p[0] as usize] += 1 + TOUCHING_COST * a as usize;
         }
         for g in 0..n {
             first[g + 1] += first[g];
-            cost[g + 1] += cost[g];
         }
         // Ranges with about the same cost each (the grains of rough walls, last in the
         // index space, own no pairs). They stay close to the equal ranges of the per-grain
-        // stages, so that each thread mostly works on the same grains.
+        // stages, so that each thread mostly works on the same grains. The cross pairs
+        // cost their thread more (they are sorted out one by one and read the grains of
+        // another thread): cut once, count them, cut again.
         let t = self.scratch.len();
-        self.bounds.clear();
-        self.bounds.push(0);
-        for r in 1..t {
-            let target = cost[n] * r / t;
-            let g = cost.partition_point(|&c| c < target).min(n);
-            self.bounds.push(g.max(*self.bounds.last().unwrap()));
+        self.bounds = balanced(&cost, t);
+        for p in pairs {
+            if range_of(p[0] as usize, &self.bounds) != range_of(p[1] as usize, &self.bounds) {
+                cost[p[0] as usize] += CROSS_COST;
+            }
         }
-        self.bounds.push(n);
+        self.bounds = balanced(&cost, t);
         self.pair_bounds = self.bounds.iter().map(|&g| first[g]).collect();
-        let range_of = |g: usize, b: &[usize]| b.partition_point(|&x| x <= g) - 1;
         self.cross.clear();
         self.cross_in_part.clear();
         self.cross_bounds = vec![0];
@@ -173,8 +233,6 @@ impl<const ENERGY: bool> ParallelPairForces<ENERGY> {
             }
             self.cross_bounds.push(self.cross.len());
         }
-        self.cross_out.clear();
-        self.cross_out.resize(self.cross.len(), PairOut::default());
     }
 }
 
@@ -201,41 +259,9 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
         let (cross, cross_in_part, incoming) = (&self.cross, &self.cross_in_part, &self.incoming);
         let threads = &self.threads;
         {
-            // (1) The cross pairs, into their slots, shared evenly between the threads
-            // whoever owns them (nearly all have their first grain in the first range: the
-            // rough walls' grains are last in the index space): thread r takes slots
-            // sb[r]..sb[r + 1], whose pairs lie in the list part kb[r]..kb[r + 1].
-            let t = self.scratch.len();
-            let sb: Vec<usize> = (0..=t).map(|r| r * cross.len() / t).collect();
-            let kb: Vec<usize> = sb.iter().enumerate().map(|(r, &s)| if r == 0 { 0 } else if s < cross.len() { cross[s] as usize } else { np }).collect();
-            let kb_ledger = energy_cuts::<ENERGY>(&kb);
-            let parts = cut(&mut w.pairs.hist, &kb)
-                .into_iter()
-                .zip(cut(&mut w.pairs.active, &kb))
-                .zip(cut(&mut self.ledgers, &kb_ledger).into_iter().zip(cut(&mut w.pairs.energy, &kb_ledger)))
-                .zip(cut(&mut self.cross_out, &sb))
-                .zip(self.scratch.iter_mut());
-            threads.each(parts.collect(), |r, ((((hist, active), (ledgers, energy)), out), sc)| {
-                // As the serial stage does: sort out the touching and released ones, then
-                // the touching ones four at a time in lanes.
-                let (k0, slots) = (kb[r], &cross[sb[r]..sb[r + 1]]);
-                let (nt, nr) = sort_listed(&view, pairs, reach, active, k0, slots, sc);
-                let mut none = EnergyLedger::default();
-                let l = if ENERGY { Ledgers::PerPair(ledgers) } else { Ledgers::One(&mut none) };
-                let list = PairSlices::<T> { pairs: checked.part(k0..kb[r + 1]), consts: &consts[k0..kb[r + 1]], hist, energy, active };
-                out.fill(PairOut::default());
-                // Touching pairs come in list order, as the slots are.
-                let mut slot = 0;
-                let sink = |k: usize, _, o: PairOut| {
-                    while slots[slot] as usize != k0 + k {
-                        slot += 1;
-                    }
-                    out[slot] = o;
-                };
-                compute_pairs::<Dm, T, ENERGY>(&view, list, &sc.touching[..nt], &sc.sep[..nt], &sc.released[..nr], l, sink, &mut sc.pending);
-            });
-            let cross_out = &self.cross_out;
-            // (2) Each range: incoming cross pairs, then its own part of the list.
+            // What each thread computed of its cross pairs, for the threads of their second
+            // grains to read once it is there.
+            let published: Vec<OnceLock<&[PairOut]>> = (0..self.scratch.len()).map(|_| OnceLock::new()).collect();
             let parts = cut(&mut w.pairs.hist, pb)
                 .into_iter()
                 .zip(cut(&mut w.pairs.active, pb))
@@ -245,19 +271,48 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
                 .zip(self.scratch.iter_mut());
             threads.each(parts.collect(), |r, (((((hist, active), (ledgers, energy)), fl), tl), sc)| {
                 let (g0, part) = (bounds[r], pb[r]..pb[r + 1]);
+                let Scratch { touching, sep, released, pending, worst, cross_out } = sc;
+                // If this thread panics before it publishes, the others must not wait for it.
+                let _guard = Publish(&published[r]);
+                let mut none = EnergyLedger::default();
+                let mut ledgers = if ENERGY { Ledgers::PerPair(ledgers) } else { Ledgers::One(&mut none) };
+                // (1) Our cross pairs first, as the serial stage does its pairs: sort out the
+                // touching and released ones, then the touching ones four at a time.
+                let slots = &cross[cb[r]..cb[r + 1]];
+                let (nt, nr) = sort_listed(&view, pairs, reach, active, part.start, slots, touching, sep, released);
+                cross_out.clear();
+                cross_out.resize(slots.len(), PairOut::default());
+                {
+                    let list = PairSlices::<T> { pairs: checked.part(part.clone()), consts: &consts[part.clone()], hist: &mut *hist, energy: &mut *energy, active: &mut *active };
+                    // Touching pairs come in list order, as the slots are.
+                    let mut slot = 0;
+                    let sink = |k: usize, _, o: PairOut| {
+                        while slots[slot] as usize != part.start + k {
+                            slot += 1;
+                        }
+                        cross_out[slot] = o;
+                    };
+                    compute_pairs::<Dm, T, ENERGY>(&view, list, &touching[..nt], &sep[..nt], &released[..nr], ledgers.reborrow(), sink, pending);
+                }
+                let own_cross: &[PairOut] = cross_out;
+                let _ = published[r].set(own_cross);
+                // (2) Sort out the rest of our part.
+                let (nt, nr) = sort_pairs(&view.p.x, &view.boundary, checked.part(part.clone()), &reach[part.clone()], active, &cross_in_part[cb[r]..cb[r + 1]], touching, sep, released);
+                // (3) The cross pairs into our grains from earlier ranges: they are first in
+                // each of those grains' sequences.
                 for &s in &incoming[r] {
-                    let o = &cross_out[s as usize];
+                    let s = s as usize;
+                    let from = cb.partition_point(|&c| c <= s) - 1;
+                    let o = &wait(&published[from])[s - cb[from]];
                     if o.ratio > 0.0 {
-                        let g = pairs[cross[s as usize] as usize][1] as usize - g0;
+                        let g = pairs[cross[s] as usize][1] as usize - g0;
                         fl[g] -= o.force;
                         if T::FRICTION {
                             tl[g] -= o.torque[1];
                         }
                     }
                 }
-                let (nt, nr) = sort_pairs(&view.p.x, &view.boundary, checked.part(part.clone()), &reach[part.clone()], active, &cross_in_part[cb[r]..cb[r + 1]], &mut sc.touching, &mut sc.sep, &mut sc.released);
-                let mut none = EnergyLedger::default();
-                let l = if ENERGY { Ledgers::PerPair(ledgers) } else { Ledgers::One(&mut none) };
+                // (4) Our pairs, each force to its grains as the kernel hands it over.
                 let list = PairSlices::<T> { pairs: checked.part(part.clone()), consts: &consts[part.clone()], hist, energy, active };
                 let mut add = |(i, j): (usize, usize), o: &PairOut, own: bool| {
                     fl[i - g0] += o.force;
@@ -271,14 +326,13 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
                         }
                     }
                 };
-                // Each own pair's force goes to its grains as the kernel hands it over.
                 let sink = |_, ij: (usize, usize), o: PairOut| add(ij, &o, true);
-                let (ratio, kk) = compute_pairs::<Dm, T, ENERGY>(&view, list, &sc.touching[..nt], &sc.sep[..nt], &sc.released[..nr], l, sink, &mut sc.pending);
+                let (ratio, kk) = compute_pairs::<Dm, T, ENERGY>(&view, list, &touching[..nt], &sep[..nt], &released[..nr], ledgers, sink, pending);
                 let mut best = if kk == usize::MAX { (0.0, usize::MAX) } else { (ratio, part.start + kk) };
-                // Then the cross pairs from our grains: a grain's pairs (g, j) with j in a
-                // later range are the last of its sequence.
-                for c in cb[r]..cb[r + 1] {
-                    let (oc, k) = (&cross_out[c], cross[c] as usize);
+                // (5) Our cross pairs' forces on our grains: a grain's pairs (g, j) with j in
+                // a later range are the last of its sequence.
+                for (&k, oc) in slots.iter().zip(own_cross) {
+                    let k = k as usize;
                     if oc.ratio > 0.0 {
                         add((pairs[k][0] as usize, pairs[k][1] as usize), oc, false);
                         if oc.ratio > best.0 || (oc.ratio == best.0 && k < best.1) {
@@ -286,7 +340,7 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
                         }
                     }
                 }
-                sc.worst = best;
+                *worst = best;
             });
         }
         w.p.f = f;

@@ -377,6 +377,13 @@ pub enum Ledgers<'a> {
 }
 
 impl Ledgers<'_> {
+    /// The same ledgers, for a shorter while.
+    pub fn reborrow(&mut self) -> Ledgers<'_> {
+        match self {
+            Ledgers::One(l) => Ledgers::One(l),
+            Ledgers::PerPair(v) => Ledgers::PerPair(v),
+        }
+    }
     #[inline(always)]
     fn get(&mut self, k: usize) -> &mut EnergyLedger {
         match self {

@@ -6,8 +6,8 @@
 //! bits do not depend on the number of threads. Without the feature (or with one thread)
 //! the loop runs once over everything, with no overhead.
 //!
-//! A step hands work to the threads about nine times (each per-grain stage, the contact
-//! stage twice), each for some tens of microseconds. rayon's pool puts idle workers to
+//! A step hands work to the threads several times (each per-grain stage and the contact
+//! stage), each for some tens of microseconds. rayon's pool puts idle workers to
 //! sleep and wakes them through the kernel, which cost about as much as the work itself
 //! here (measured: 1.16x on two cores at 20 000 grains). So the pool is a small
 //! fork-join of its own: the calling thread is thread 0, the others spin on an epoch
