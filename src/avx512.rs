@@ -57,6 +57,8 @@ pub fn sweep_eights(
     // eight: so within `end`.
     let xs = pairs.of(x);
     assert!(end <= pairs.len() && end <= reach.len() && end <= active.len());
+    // The gathers take a grain index doubled as an i32 offset.
+    assert!(x.len() <= 1 << 30, "{} grains: the AVX-512 sweep takes at most 2^30", x.len());
     assert!(t <= range.start && r <= range.start && end <= touching.len().min(sep.len()).min(released.len()));
     assert!(skip.first().is_none_or(|&k| k as usize >= range.start) && skip.is_sorted());
     let list = pairs.pairs().as_ptr();
@@ -87,7 +89,7 @@ unsafe fn eights(list: *const [u32; 2], xp: *const f64, boundary: &Boundary, rea
             left_out |= 1 << (m - k);
         }
         // SAFETY: see the caller; a grain index doubled is a positive i32 offset
-        // below 2^31 (2^30 grains would take 400 GB).
+        // (asserted there: fewer than 2^30 grains).
         unsafe {
             // Eight pairs as eight u64 (j << 32 | i): i and j as eight u32 each.
             let p = _mm512_loadu_si512(list.add(k) as *const __m512i);
