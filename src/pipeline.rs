@@ -749,9 +749,9 @@ mod tests {
     use rand::{Rng, SeedableRng};
 
     /// The AVX-512 sweep gives the portable sweep's lists and separations, bit for bit:
-    /// across the periodic seam and without periodicity, with pairs released, and for
-    /// stretches of every length between skipped pairs (so with every tail the eight-wide
-    /// loop leaves to the portable one).
+    /// across the periodic seam and without periodicity, with pairs released, and with
+    /// skipped pairs at every lane position (masked in the eight-wide blocks, between
+    /// stretches in the portable sweep that takes the tail).
     #[cfg(all(target_arch = "x86_64", target_feature = "avx512f", target_feature = "avx512vl", target_feature = "avx512bw"))]
     #[test]
     fn avx512_sweep_gives_the_portable_bits() {
