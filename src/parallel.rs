@@ -150,7 +150,7 @@ fn sort_listed<L: crate::contact::ContactLaw>(view: &PairView<'_, L>, pairs: &[[
     (nt, nr)
 }
 
-/// The range of grain `g` for range bounds `b`.
+/// The range of grain `g` for range bounds `b` (or of slot `g` for slot bounds).
 fn range_of(g: usize, b: &[usize]) -> usize {
     b.partition_point(|&x| x <= g) - 1
 }
@@ -302,7 +302,8 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
                 // each of those grains' sequences.
                 for &s in &incoming[r] {
                     let s = s as usize;
-                    let from = cb.partition_point(|&c| c <= s) - 1;
+                    // The thread whose cross pairs hold slot s.
+                    let from = range_of(s, cb);
                     let o = &wait(&published[from])[s - cb[from]];
                     if o.ratio > 0.0 {
                         let g = pairs[cross[s] as usize][1] as usize - g0;
