@@ -122,3 +122,209 @@ unsafe fn eights(list: *const [u32; 2], xp: *const f64, boundary: &Boundary, rea
         k += WIDTH;
     }
 }
+
+/// The arrays of one thread's part of the free grains for [`drift`] and [`kick`]: with
+/// `ROT` also the spin, torque and spin kick factor; empty otherwise.
+pub struct GrainPart<'a> {
+    pub v: &'a mut [Vec2],
+    pub f: &'a [Vec2],
+    /// dt/2 / m, s/kg.
+    pub dtfm: &'a [f64],
+    pub omega: &'a mut [f64],
+    pub torque: &'a [f64],
+    /// dt/2 / I, s/(kg m^2).
+    pub dtfi: &'a [f64],
+}
+
+impl GrainPart<'_> {
+    /// The grains all arrays cover (the spin arrays only with `ROT`), in whole eights.
+    fn eights<const ROT: bool>(&self) -> usize {
+        let mut n = self.v.len().min(self.f.len()).min(self.dtfm.len());
+        if ROT {
+            n = n.min(self.omega.len()).min(self.torque.len()).min(self.dtfi.len());
+        }
+        n / WIDTH * WIDTH
+    }
+}
+
+/// The first half kick and the drift of the grains `0..8 m` of a part (the largest
+/// multiple of eight it holds), as [`crate::integrate::InitialIntegrate`] does them grain
+/// by grain: `v += dtfm f`, `x += dt v` (`ROT`: `w += dtfi M`), with the same operations
+/// (a multiply, then an add; none fused), so the same bits. In the same pass, the watch
+/// of the neighbour list (any grain farther than `limit.sqrt()` from `at`, its place at
+/// the last build, minimum image in x) and whether any grain left the periodic cell (then
+/// the caller wraps them and watches again). Eight grains at a time in two registers
+/// per vector array, (x, y) pairs as they are stored: the portable loop splits the pairs
+/// into x and y registers and back, and that shuffling, not memory, bounded it. Returns
+/// (grains done, far, outside).
+pub fn drift<const ROT: bool>(g: GrainPart<'_>, x: &mut [Vec2], at: &[Vec2], dt: f64, boundary: &Boundary, limit: f64) -> (usize, bool, bool) {
+    let end = g.eights::<ROT>().min(x.len()).min(at.len());
+    // SAFETY: the module is compiled only for AVX-512F; every array is read or written
+    // below `end` grains.
+    let (far, out) = unsafe { drift_eights::<ROT>(end, g, x.as_mut_ptr() as *mut f64, at.as_ptr() as *const f64, dt, boundary, limit) };
+    (end, far, out)
+}
+
+/// The loop of [`drift`] over `end` grains (a multiple of eight).
+#[target_feature(enable = "avx512f")]
+unsafe fn drift_eights<const ROT: bool>(end: usize, g: GrainPart<'_>, x: *mut f64, at: *const f64, dt: f64, boundary: &Boundary, limit: f64) -> (bool, bool) {
+    let (v, f, m) = (g.v.as_mut_ptr() as *mut f64, g.f.as_ptr() as *const f64, g.dtfm.as_ptr());
+    let (w, t, mi) = (g.omega.as_mut_ptr(), g.torque.as_ptr(), g.dtfi.as_ptr());
+    let (lo, hi) = (_mm512_setr_epi64(0, 0, 1, 1, 2, 2, 3, 3), _mm512_setr_epi64(4, 4, 5, 5, 6, 6, 7, 7));
+    let dtv = _mm512_set1_pd(dt);
+    // The minimum image acts on the x lanes only: y lanes get period and 1/period 0, so
+    // that they keep their value (d - 0 * 0).
+    let (p, ip) = (boundary.period, boundary.inv_period());
+    let period = _mm512_setr_pd(p, 0.0, p, 0.0, p, 0.0, p, 0.0);
+    let inv_period = _mm512_setr_pd(ip, 0.0, ip, 0.0, ip, 0.0, ip, 0.0);
+    let (shift, exact) = (_mm512_set1_pd(ROUND_SHIFT), _mm512_set1_pd(ROUND_EXACT_FROM));
+    let (x_min, full, zero, lim) = (_mm512_set1_pd(boundary.x_min), _mm512_set1_pd(p), _mm512_setzero_pd(), _mm512_set1_pd(limit));
+    let periodic = boundary.is_periodic();
+    let (mut far, mut out) = (0u8, 0u8);
+    let mut k = 0;
+    while k < end {
+        // SAFETY: grains k..k + 8 < end, covered by every array (the caller).
+        unsafe {
+            let m8 = _mm512_loadu_pd(m.add(k));
+            for (h, idx) in [(0, lo), (1, hi)] {
+                // Four grains: (x, y) pairs in one register, their factor twice.
+                let o = 2 * k + 8 * h;
+                let mm = _mm512_permutexvar_pd(idx, m8);
+                let vv = _mm512_add_pd(_mm512_loadu_pd(v.add(o)), _mm512_mul_pd(mm, _mm512_loadu_pd(f.add(o))));
+                _mm512_storeu_pd(v.add(o), vv);
+                let xx = _mm512_add_pd(_mm512_loadu_pd(x.add(o)), _mm512_mul_pd(dtv, vv));
+                _mm512_storeu_pd(x.add(o), xx);
+                // The watch: |image(x - at)|^2 > limit, as Neighbours::moved.
+                let d = _mm512_sub_pd(xx, _mm512_loadu_pd(at.add(o)));
+                let s = _mm512_mul_pd(d, inv_period);
+                let small = _mm512_cmp_pd_mask::<_CMP_LT_OQ>(_mm512_abs_pd(s), exact);
+                let s = _mm512_mask_blend_pd(small, s, _mm512_sub_pd(_mm512_add_pd(s, shift), shift));
+                let d = _mm512_sub_pd(d, _mm512_mul_pd(period, s));
+                let d2 = _mm512_mul_pd(d, d);
+                // x x + y y in the x lanes.
+                let r2 = _mm512_add_pd(d2, _mm512_permute_pd::<0b0101_0101>(d2));
+                far |= _mm512_cmp_pd_mask::<_CMP_GT_OQ>(r2, lim) & 0x55;
+                // Outside the cell: not 0 <= x - x_min < period (x lanes).
+                if periodic {
+                    let xr = _mm512_sub_pd(xx, x_min);
+                    let inside = _mm512_cmp_pd_mask::<_CMP_GE_OQ>(xr, zero) & _mm512_cmp_pd_mask::<_CMP_LT_OQ>(xr, full);
+                    out |= !inside & 0x55;
+                }
+            }
+            if ROT {
+                let ww = _mm512_add_pd(_mm512_loadu_pd(w.add(k)), _mm512_mul_pd(_mm512_loadu_pd(mi.add(k)), _mm512_loadu_pd(t.add(k))));
+                _mm512_storeu_pd(w.add(k), ww);
+            }
+        }
+        k += WIDTH;
+    }
+    (far != 0, out != 0)
+}
+
+/// The second half kick of the grains `0..8 m` of a part, as
+/// [`crate::integrate::FinalIntegrate`] does it grain by grain (`v += dtfm f`; `ROT`:
+/// `w += dtfi M`), with the same operations, eight grains at a time. Returns the grains done.
+pub fn kick<const ROT: bool>(g: GrainPart<'_>) -> usize {
+    let end = g.eights::<ROT>();
+    // SAFETY: the module is compiled only for AVX-512F; every array is read or written
+    // below `end` grains.
+    unsafe { kick_eights::<ROT>(end, g) };
+    end
+}
+
+/// The loop of [`kick`] over `end` grains (a multiple of eight).
+#[target_feature(enable = "avx512f")]
+unsafe fn kick_eights<const ROT: bool>(end: usize, g: GrainPart<'_>) {
+    let (v, f, m) = (g.v.as_mut_ptr() as *mut f64, g.f.as_ptr() as *const f64, g.dtfm.as_ptr());
+    let (w, t, mi) = (g.omega.as_mut_ptr(), g.torque.as_ptr(), g.dtfi.as_ptr());
+    let (lo, hi) = (_mm512_setr_epi64(0, 0, 1, 1, 2, 2, 3, 3), _mm512_setr_epi64(4, 4, 5, 5, 6, 6, 7, 7));
+    let mut k = 0;
+    while k < end {
+        // SAFETY: grains k..k + 8 < end, covered by every array (the caller).
+        unsafe {
+            let m8 = _mm512_loadu_pd(m.add(k));
+            for (h, idx) in [(0, lo), (1, hi)] {
+                let o = 2 * k + 8 * h;
+                let vv = _mm512_add_pd(_mm512_loadu_pd(v.add(o)), _mm512_mul_pd(_mm512_permutexvar_pd(idx, m8), _mm512_loadu_pd(f.add(o))));
+                _mm512_storeu_pd(v.add(o), vv);
+            }
+            if ROT {
+                let ww = _mm512_add_pd(_mm512_loadu_pd(w.add(k)), _mm512_mul_pd(_mm512_loadu_pd(mi.add(k)), _mm512_loadu_pd(t.add(k))));
+                _mm512_storeu_pd(w.add(k), ww);
+            }
+        }
+        k += WIDTH;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::neighbor::Neighbours;
+    use rand::{Rng, SeedableRng};
+
+    /// Random grains of a part: velocities, forces, factors, spins; positions spread over
+    /// a periodic cell [-0.5, 0.5) with some next to either edge, and their places at the
+    /// last build (a few far from there).
+    #[allow(clippy::type_complexity)]
+    fn grains(n: usize, seed: u64) -> (Vec<Vec2>, Vec<Vec2>, Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>, Vec<Vec2>, Vec<Vec2>) {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        let mut u = |a: f64, b: f64| a + (b - a) * rng.random::<f64>();
+        let v = (0..n).map(|_| Vec2::new(u(-1.0, 1.0), u(-1.0, 1.0))).collect();
+        let f = (0..n).map(|_| Vec2::new(u(-1e-2, 1e-2), u(-1e-2, 1e-2))).collect();
+        let dtfm = (0..n).map(|_| u(1e-6, 1e-4)).collect();
+        let omega = (0..n).map(|_| u(-1e3, 1e3)).collect();
+        let torque = (0..n).map(|_| u(-1e-6, 1e-6)).collect();
+        let dtfi = (0..n).map(|_| u(1e-1, 1e1)).collect();
+        let x: Vec<Vec2> = (0..n).map(|k| Vec2::new(if k % 7 == 0 { 0.5 - 1e-9 } else if k % 11 == 0 { -0.5 } else { u(-0.5, 0.5) }, u(0.0, 0.1))).collect();
+        // A few far away in y, beyond half the period: the minimum image is in x only.
+        let at = x.iter().enumerate().map(|(k, x)| x + if k % 13 == 0 { Vec2::new(2e-3, 0.0) } else if k % 17 == 0 { Vec2::new(0.0, 0.7) } else { Vec2::new(u(-1e-4, 1e-4), u(-1e-4, 1e-4)) }).collect();
+        (v, f, dtfm, omega, torque, dtfi, x, at)
+    }
+
+    /// The AVX-512 drift gives the portable loops' bits (velocities, positions, spins)
+    /// and the same watch (far) and periodic (outside) findings: with and without
+    /// periodicity, lengths that are and are not whole eights, grains that leave the cell
+    /// and grains past the limit (in x, or in y by more than half the period), or none.
+    /// Fails with a fused multiply-add, or with the minimum image on the y lanes (tried).
+    #[test]
+    fn drift_and_kick_give_the_portable_bits() {
+        let dt = 1e-3;
+        for boundary in [Boundary::periodic_x(-0.5, 1.0), Boundary::open()] {
+            for (n, seed) in [(64, 1), (61, 2), (7, 3), (200, 4)] {
+                for (limit, far_somewhere) in [(1e-6, true), (0.25, true), (1.0, false)] {
+                    let (mut v, f, dtfm, mut omega, torque, dtfi, mut x, at) = grains(n, seed);
+                    let (mut v0, mut x0, mut omega0) = (v.clone(), x.clone(), omega.clone());
+                    for k in 0..n {
+                        v0[k] += dtfm[k] * f[k];
+                        x0[k] += dt * v0[k];
+                        omega0[k] += dtfi[k] * torque[k];
+                    }
+                    let (far0, out0) = (Neighbours::moved(&x0, &at, &boundary, limit), boundary.any_outside(&x0));
+                    let (done, far, out) = drift::<true>(GrainPart { v: &mut v, f: &f, dtfm: &dtfm, omega: &mut omega, torque: &torque, dtfi: &dtfi }, &mut x, &at, dt, &boundary, limit);
+                    assert_eq!(done, n / WIDTH * WIDTH);
+                    let bits = |a: &[Vec2]| a[..done].iter().map(|p| [p.x.to_bits(), p.y.to_bits()]).collect::<Vec<_>>();
+                    assert_eq!(bits(&v), bits(&v0), "v, n = {n}");
+                    assert_eq!(bits(&x), bits(&x0), "x, n = {n}");
+                    assert_eq!(omega[..done].iter().map(|w| w.to_bits()).collect::<Vec<_>>(), omega0[..done].iter().map(|w| w.to_bits()).collect::<Vec<_>>());
+                    // The eights' findings are those of the same grains' portable watch.
+                    assert_eq!(far, Neighbours::moved(&x0[..done], &at[..done], &boundary, limit), "far, n = {n}, limit {limit}");
+                    assert_eq!(out, boundary.any_outside(&x0[..done]), "outside, n = {n}");
+                    if done == n && n > 60 {
+                        assert_eq!((far, out), (far0, out0));
+                        assert_eq!(far, far_somewhere, "the test has grains past the limit {limit}");
+                        assert_eq!(out, boundary.is_periodic(), "the test has grains outside the periodic cell");
+                    }
+                    let (mut v1, mut omega1) = (v0.clone(), omega0.clone());
+                    let done = kick::<true>(GrainPart { v: &mut v0, f: &f, dtfm: &dtfm, omega: &mut omega0, torque: &torque, dtfi: &dtfi });
+                    for k in 0..done {
+                        v1[k] += dtfm[k] * f[k];
+                        omega1[k] += dtfi[k] * torque[k];
+                    }
+                    assert_eq!(bits(&v0[..done]), bits(&v1[..done]), "kick v, n = {n}");
+                    assert_eq!(omega0[..done].iter().map(|w| w.to_bits()).collect::<Vec<_>>(), omega1[..done].iter().map(|w| w.to_bits()).collect::<Vec<_>>());
+                }
+            }
+        }
+    }
+}

@@ -38,6 +38,19 @@ impl Boundary {
         d.x -= R::splat(self.period) * s;
         d
     }
+    /// Whether any of the positions `x` is outside the periodic cell (false without
+    /// periodicity). A full sweep without an early exit, so that it vectorises.
+    #[inline(always)]
+    pub fn any_outside(&self, x: &[Vec2]) -> bool {
+        if !self.is_periodic() {
+            return false;
+        }
+        let (lo, period) = (self.x_min, self.period);
+        x.iter().fold(false, |out, x| {
+            let xr = x.x - lo;
+            out | !(xr >= 0.0 && xr < period)
+        })
+    }
     /// Bring a position back into [x_min, x_min + period).
     #[inline(always)]
     pub fn wrap(&self, x: &mut Vec2) {

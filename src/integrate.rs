@@ -41,9 +41,9 @@ impl KickFactors {
     }
 }
 
-/// First half kick and drift of the free grains; `ROT` adds the spin half kick. In the
-/// same pass over the grains: back into the periodic cell, and the neighbour list's
-/// watch (has a grain moved more than half the skin since the last build?).
+/// First half kick and drift of the free grains; `ROT` adds the spin half kick. Then
+/// back into the periodic cell, and the neighbour list's watch (has a grain moved more
+/// than half the skin since the last build?): with AVX-512 in the same pass.
 #[derive(Default)]
 pub struct InitialIntegrate<const ROT: bool> {
     /// Stands in for the positions at the last build before there is a build.
@@ -71,18 +71,32 @@ impl<L: ContactLaw, const ROT: bool> Stage<L> for InitialIntegrate<ROT> {
         let translation = (&mut p.v[..n], &mut p.x[..n], &p.f[..n], &k.dtfm[..], at);
         let rotation = (&mut p.omega[..n], &p.torque[..n], &k.dtfi[..]);
         w.threads.split(n, (translation, rotation), |((v, x, f, dtfm, at), (omega, torque, dtfi))| {
-            for (((v, x), f), m) in v.iter_mut().zip(x.iter_mut()).zip(f).zip(dtfm) {
+            // Where the build has AVX-512, eight grains at a time first (the same bits).
+            #[cfg(all(target_arch = "x86_64", target_feature = "avx512f", target_feature = "avx512vl", target_feature = "avx512bw"))]
+            let (from, mut far_here, out) = {
+                let g = crate::avx512::GrainPart { v: &mut *v, f, dtfm, omega: &mut *omega, torque, dtfi };
+                crate::avx512::drift::<ROT>(g, &mut *x, at, dt, &b, limit)
+            };
+            #[cfg(not(all(target_arch = "x86_64", target_feature = "avx512f", target_feature = "avx512vl", target_feature = "avx512bw")))]
+            let (from, mut far_here, out) = (0, false, false);
+            for (((v, x), f), m) in v[from..].iter_mut().zip(x[from..].iter_mut()).zip(&f[from..]).zip(&dtfm[from..]) {
                 *v += *m * *f;
                 *x += dt * *v;
-                b.wrap(x);
-            }
-            if Neighbours::moved(x, at, &b, limit) {
-                far.store(true, Ordering::Relaxed);
             }
             if ROT {
-                for ((w, t), m) in omega.iter_mut().zip(torque).zip(dtfi) {
+                for ((w, t), m) in omega[from..].iter_mut().zip(&torque[from..]).zip(&dtfi[from..]) {
                     *w += *m * *t;
                 }
+            }
+            // Back into the periodic cell: rarely anyone to bring back, so one check of
+            // all first (the wrap itself is a chain of roundings per grain).
+            let mut watch = from;
+            if out || b.any_outside(&x[from..]) {
+                x.iter_mut().for_each(|x| b.wrap(x));
+                (far_here, watch) = (false, 0);
+            }
+            if far_here || Neighbours::moved(&x[watch..], &at[watch..], &b, limit) {
+                far.store(true, Ordering::Relaxed);
             }
         });
         w.neighbours.moved_far |= far.into_inner();
@@ -105,11 +119,15 @@ impl<L: ContactLaw, const ROT: bool> Stage<L> for FinalIntegrate<ROT> {
         k.update(p, w.dt);
         let rotation = (&mut p.omega[..n], &p.torque[..n], &k.dtfi[..]);
         w.threads.split(n, ((&mut p.v[..n], &p.f[..n], &k.dtfm[..]), rotation), |((v, f, dtfm), (omega, torque, dtfi))| {
-            for ((v, f), m) in v.iter_mut().zip(f).zip(dtfm) {
+            #[cfg(all(target_arch = "x86_64", target_feature = "avx512f", target_feature = "avx512vl", target_feature = "avx512bw"))]
+            let from = crate::avx512::kick::<ROT>(crate::avx512::GrainPart { v: &mut *v, f, dtfm, omega: &mut *omega, torque, dtfi });
+            #[cfg(not(all(target_arch = "x86_64", target_feature = "avx512f", target_feature = "avx512vl", target_feature = "avx512bw")))]
+            let from = 0;
+            for ((v, f), m) in v[from..].iter_mut().zip(&f[from..]).zip(&dtfm[from..]) {
                 *v += *m * *f;
             }
             if ROT {
-                for ((w, t), m) in omega.iter_mut().zip(torque).zip(dtfi) {
+                for ((w, t), m) in omega[from..].iter_mut().zip(&torque[from..]).zip(&dtfi[from..]) {
                     *w += *m * *t;
                 }
             }
