@@ -124,14 +124,15 @@ unsafe fn eights(list: *const [u32; 2], xp: *const f64, boundary: &Boundary, rea
 }
 
 /// The arrays of one thread's part of the free grains for [`drift`] and [`kick`]: with
-/// `ROT` also the spin, torque and spin kick factor; empty otherwise.
+/// `ROT` also the spin, torque and spin kick factor; empty otherwise. (The drift sets the
+/// forces and torques to zero once it has used them; the kick leaves them.)
 pub struct GrainPart<'a> {
     pub v: &'a mut [Vec2],
-    pub f: &'a [Vec2],
+    pub f: &'a mut [Vec2],
     /// dt/2 / m, s/kg.
     pub dtfm: &'a [f64],
     pub omega: &'a mut [f64],
-    pub torque: &'a [f64],
+    pub torque: &'a mut [f64],
     /// dt/2 / I, s/(kg m^2).
     pub dtfi: &'a [f64],
 }
@@ -150,7 +151,8 @@ impl GrainPart<'_> {
 /// The first half kick and the drift of the grains `0..8 m` of a part (the largest
 /// multiple of eight it holds), as [`crate::integrate::InitialIntegrate`] does them grain
 /// by grain: `v += dtfm f`, `x += dt v` (`ROT`: `w += dtfi M`), with the same operations
-/// (a multiply, then an add; none fused), so the same bits. In the same pass, the watch
+/// (a multiply, then an add; none fused), so the same bits; the forces and torques used
+/// are set to zero (`World::zeroed`). In the same pass, the watch
 /// of the neighbour list (any grain farther than `limit.sqrt()` from `at`, its place at
 /// the last build, minimum image in x) and whether any grain left the periodic cell (then
 /// the caller wraps them and watches again). Eight grains at a time in two registers
@@ -168,8 +170,8 @@ pub fn drift<const ROT: bool>(g: GrainPart<'_>, x: &mut [Vec2], at: &[Vec2], dt:
 /// The loop of [`drift`] over `end` grains (a multiple of eight).
 #[target_feature(enable = "avx512f")]
 unsafe fn drift_eights<const ROT: bool>(end: usize, g: GrainPart<'_>, x: *mut f64, at: *const f64, dt: f64, boundary: &Boundary, limit: f64) -> (bool, bool) {
-    let (v, f, m) = (g.v.as_mut_ptr() as *mut f64, g.f.as_ptr() as *const f64, g.dtfm.as_ptr());
-    let (w, t, mi) = (g.omega.as_mut_ptr(), g.torque.as_ptr(), g.dtfi.as_ptr());
+    let (v, f, m) = (g.v.as_mut_ptr() as *mut f64, g.f.as_mut_ptr() as *mut f64, g.dtfm.as_ptr());
+    let (w, t, mi) = (g.omega.as_mut_ptr(), g.torque.as_mut_ptr(), g.dtfi.as_ptr());
     let (lo, hi) = (_mm512_setr_epi64(0, 0, 1, 1, 2, 2, 3, 3), _mm512_setr_epi64(4, 4, 5, 5, 6, 6, 7, 7));
     let dtv = _mm512_set1_pd(dt);
     // The minimum image acts on the x lanes only: y lanes get period and 1/period 0, so
@@ -192,6 +194,7 @@ unsafe fn drift_eights<const ROT: bool>(end: usize, g: GrainPart<'_>, x: *mut f6
                 let mm = _mm512_permutexvar_pd(idx, m8);
                 let vv = _mm512_add_pd(_mm512_loadu_pd(v.add(o)), _mm512_mul_pd(mm, _mm512_loadu_pd(f.add(o))));
                 _mm512_storeu_pd(v.add(o), vv);
+                _mm512_storeu_pd(f.add(o), _mm512_setzero_pd());
                 let xx = _mm512_add_pd(_mm512_loadu_pd(x.add(o)), _mm512_mul_pd(dtv, vv));
                 _mm512_storeu_pd(x.add(o), xx);
                 // The watch: |image(x - at)|^2 > limit, as Neighbours::moved.
@@ -214,6 +217,7 @@ unsafe fn drift_eights<const ROT: bool>(end: usize, g: GrainPart<'_>, x: *mut f6
             if ROT {
                 let ww = _mm512_add_pd(_mm512_loadu_pd(w.add(k)), _mm512_mul_pd(_mm512_loadu_pd(mi.add(k)), _mm512_loadu_pd(t.add(k))));
                 _mm512_storeu_pd(w.add(k), ww);
+                _mm512_storeu_pd(t.add(k), _mm512_setzero_pd());
             }
         }
         k += WIDTH;
@@ -301,8 +305,12 @@ mod tests {
                         omega0[k] += dtfi[k] * torque[k];
                     }
                     let (far0, out0) = (Neighbours::moved(&x0, &at, &boundary, limit), boundary.any_outside(&x0));
-                    let (done, far, out) = drift::<true>(GrainPart { v: &mut v, f: &f, dtfm: &dtfm, omega: &mut omega, torque: &torque, dtfi: &dtfi }, &mut x, &at, dt, &boundary, limit);
+                    let (mut used_f, mut used_t) = (f.clone(), torque.clone());
+                    let (done, far, out) = drift::<true>(GrainPart { v: &mut v, f: &mut used_f, dtfm: &dtfm, omega: &mut omega, torque: &mut used_t, dtfi: &dtfi }, &mut x, &at, dt, &boundary, limit);
                     assert_eq!(done, n / WIDTH * WIDTH);
+                    // The forces and torques used are zero, the rest untouched.
+                    assert!(used_f[..done].iter().all(|f| *f == Vec2::zeros()) && used_t[..done].iter().all(|&t| t == 0.0));
+                    assert!(used_f[done..] == f[done..] && used_t[done..] == torque[done..]);
                     let bits = |a: &[Vec2]| a[..done].iter().map(|p| [p.x.to_bits(), p.y.to_bits()]).collect::<Vec<_>>();
                     assert_eq!(bits(&v), bits(&v0), "v, n = {n}");
                     assert_eq!(bits(&x), bits(&x0), "x, n = {n}");
@@ -316,7 +324,7 @@ mod tests {
                         assert_eq!(out, boundary.is_periodic(), "the test has grains outside the periodic cell");
                     }
                     let (mut v1, mut omega1) = (v0.clone(), omega0.clone());
-                    let done = kick::<true>(GrainPart { v: &mut v0, f: &f, dtfm: &dtfm, omega: &mut omega0, torque: &torque, dtfi: &dtfi });
+                    let done = kick::<true>(GrainPart { v: &mut v0, f: &mut f.clone(), dtfm: &dtfm, omega: &mut omega0, torque: &mut torque.clone(), dtfi: &dtfi });
                     for k in 0..done {
                         v1[k] += dtfm[k] * f[k];
                         omega1[k] += dtfi[k] * torque[k];

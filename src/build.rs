@@ -368,6 +368,7 @@ impl Parts<'_> {
             energy: E,
             threads: self.threads.clone(),
             kick: Default::default(),
+            zeroed: Default::default(),
         };
         // The force stages, shared by the step and by the set-up at t = 0.
         let threads = self.threads.clone();

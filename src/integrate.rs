@@ -43,7 +43,9 @@ impl KickFactors {
 
 /// First half kick and drift of the free grains; `ROT` adds the spin half kick. Then
 /// back into the periodic cell, and the neighbour list's watch (has a grain moved more
-/// than half the skin since the last build?): with AVX-512 in the same pass.
+/// than half the skin since the last build?): with AVX-512 in the same pass. The forces
+/// (and torques) it has used are set to zero there ([`World::zeroed`]): the step's
+/// contact stage adds the new ones, and `ClearForces` need not pass over them again.
 #[derive(Default)]
 pub struct InitialIntegrate<const ROT: bool> {
     /// Stands in for the positions at the last build before there is a build.
@@ -68,13 +70,13 @@ impl<L: ContactLaw, const ROT: bool> Stage<L> for InitialIntegrate<ROT> {
         }
         let at = if listed { &w.neighbours.at_build()[..n] } else { &self.origin[..] };
         let far = AtomicBool::new(false);
-        let translation = (&mut p.v[..n], &mut p.x[..n], &p.f[..n], &k.dtfm[..], at);
-        let rotation = (&mut p.omega[..n], &p.torque[..n], &k.dtfi[..]);
+        let translation = (&mut p.v[..n], &mut p.x[..n], &mut p.f[..n], &k.dtfm[..], at);
+        let rotation = (&mut p.omega[..n], &mut p.torque[..n], &k.dtfi[..]);
         w.threads.split(n, (translation, rotation), |((v, x, f, dtfm, at), (omega, torque, dtfi))| {
             // Where the build has AVX-512, eight grains at a time first (the same bits).
             #[cfg(all(target_arch = "x86_64", target_feature = "avx512f", target_feature = "avx512vl", target_feature = "avx512bw"))]
             let (from, mut far_here, out) = {
-                let g = crate::avx512::GrainPart { v: &mut *v, f, dtfm, omega: &mut *omega, torque, dtfi };
+                let g = crate::avx512::GrainPart { v: &mut *v, f: &mut *f, dtfm, omega: &mut *omega, torque: &mut *torque, dtfi };
                 crate::avx512::drift::<ROT>(g, &mut *x, at, dt, &b, limit)
             };
             #[cfg(not(all(target_arch = "x86_64", target_feature = "avx512f", target_feature = "avx512vl", target_feature = "avx512bw")))]
@@ -83,10 +85,13 @@ impl<L: ContactLaw, const ROT: bool> Stage<L> for InitialIntegrate<ROT> {
                 *v += *m * *f;
                 *x += dt * *v;
             }
+            // The forces (and torques) are used: zero for the step's contacts to add to.
+            f[from..].fill(Vec2::zeros());
             if ROT {
                 for ((w, t), m) in omega[from..].iter_mut().zip(&torque[from..]).zip(&dtfi[from..]) {
                     *w += *m * *t;
                 }
+                torque[from..].fill(0.0);
             }
             // Back into the periodic cell: rarely anyone to bring back, so one check of
             // all first (the wrap itself is a chain of roundings per grain).
@@ -100,6 +105,7 @@ impl<L: ContactLaw, const ROT: bool> Stage<L> for InitialIntegrate<ROT> {
             }
         });
         w.neighbours.moved_far |= far.into_inner();
+        w.zeroed = crate::sim::Zeroed { forces: n, torques: if ROT { n } else { 0 } };
         Ok(())
     }
 }
@@ -117,10 +123,10 @@ impl<L: ContactLaw, const ROT: bool> Stage<L> for FinalIntegrate<ROT> {
         let n = p.n_free;
         let k = &mut w.kick;
         k.update(p, w.dt);
-        let rotation = (&mut p.omega[..n], &p.torque[..n], &k.dtfi[..]);
-        w.threads.split(n, ((&mut p.v[..n], &p.f[..n], &k.dtfm[..]), rotation), |((v, f, dtfm), (omega, torque, dtfi))| {
+        let rotation = (&mut p.omega[..n], &mut p.torque[..n], &k.dtfi[..]);
+        w.threads.split(n, ((&mut p.v[..n], &mut p.f[..n], &k.dtfm[..]), rotation), |((v, f, dtfm), (omega, torque, dtfi))| {
             #[cfg(all(target_arch = "x86_64", target_feature = "avx512f", target_feature = "avx512vl", target_feature = "avx512bw"))]
-            let from = crate::avx512::kick::<ROT>(crate::avx512::GrainPart { v: &mut *v, f, dtfm, omega: &mut *omega, torque, dtfi });
+            let from = crate::avx512::kick::<ROT>(crate::avx512::GrainPart { v: &mut *v, f: &mut *f, dtfm, omega: &mut *omega, torque: &mut *torque, dtfi });
             #[cfg(not(all(target_arch = "x86_64", target_feature = "avx512f", target_feature = "avx512vl", target_feature = "avx512bw")))]
             let from = 0;
             for ((v, f), m) in v[from..].iter_mut().zip(&f[from..]).zip(&dtfm[from..]) {

@@ -79,7 +79,8 @@ impl<L: ContactLaw> Stage<L> for UpdateNeighbours {
     }
 }
 
-/// Zero forces and torques (and start the step's stored-energy sums).
+/// Zero forces and torques (and start the step's stored-energy sums): those the drift
+/// has not set to zero already ([`World::zeroed`]; in a step, the rough walls' grains).
 pub struct ClearForces;
 
 impl<L: ContactLaw> Stage<L> for ClearForces {
@@ -88,13 +89,10 @@ impl<L: ContactLaw> Stage<L> for ClearForces {
     }
     fn run(&mut self, w: &mut World<L>) -> Result<(), Error> {
         let n = w.p.len();
+        let z = std::mem::take(&mut w.zeroed);
+        w.threads.split(n - z.forces, &mut w.p.f[z.forces..], |f| f.fill(Vec2::zeros()));
         if L::Tang::FRICTION {
-            w.threads.split(n, (&mut w.p.f[..], &mut w.p.torque[..]), |(f, t)| {
-                f.fill(Vec2::zeros());
-                t.fill(0.0);
-            });
-        } else {
-            w.threads.split(n, &mut w.p.f[..], |f| f.fill(Vec2::zeros()));
+            w.threads.split(n - z.torques, &mut w.p.torque[z.torques..], |t| t.fill(0.0));
         }
         w.ledger.begin_step();
         w.max_overlap = (0.0, 0, 0);

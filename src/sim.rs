@@ -48,6 +48,10 @@ pub struct World<L: ContactLaw> {
     pub threads: crate::threads::Threads,
     /// The half-kick factors of the integrator.
     pub kick: crate::integrate::KickFactors,
+    /// How many of the first grains have zero forces (and torques) already this step:
+    /// the drift sets the free grains' to zero once it has used them, and
+    /// [`crate::pipeline::ClearForces`] clears the rest (then sets these back to 0).
+    pub zeroed: Zeroed,
 }
 
 impl<L: ContactLaw> World<L> {
@@ -104,6 +108,13 @@ impl<L: ContactLaw> World<L> {
             ),
         }
     }
+}
+
+/// The grains `0..forces` have zero forces, `0..torques` zero torques ([`World::zeroed`]).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Zeroed {
+    pub forces: usize,
+    pub torques: usize,
 }
 
 /// Largest energy balance residual, as a fraction of the energy put in, before a run is
