@@ -189,11 +189,8 @@ unsafe fn drift_eights<const ROT: bool>(end: usize, g: GrainPart<'_>, x: *mut f6
         unsafe {
             let m8 = _mm512_loadu_pd(m.add(k));
             for (h, idx) in [(0, lo), (1, hi)] {
-                // Four grains: (x, y) pairs in one register, their factor twice.
                 let o = 2 * k + 8 * h;
-                let mm = _mm512_permutexvar_pd(idx, m8);
-                let vv = _mm512_add_pd(_mm512_loadu_pd(v.add(o)), _mm512_mul_pd(mm, _mm512_loadu_pd(f.add(o))));
-                _mm512_storeu_pd(v.add(o), vv);
+                let vv = kick_four(v, f, m8, idx, o);
                 _mm512_storeu_pd(f.add(o), _mm512_setzero_pd());
                 let xx = _mm512_add_pd(_mm512_loadu_pd(x.add(o)), _mm512_mul_pd(dtv, vv));
                 _mm512_storeu_pd(x.add(o), xx);
@@ -215,14 +212,36 @@ unsafe fn drift_eights<const ROT: bool>(end: usize, g: GrainPart<'_>, x: *mut f6
                 }
             }
             if ROT {
-                let ww = _mm512_add_pd(_mm512_loadu_pd(w.add(k)), _mm512_mul_pd(_mm512_loadu_pd(mi.add(k)), _mm512_loadu_pd(t.add(k))));
-                _mm512_storeu_pd(w.add(k), ww);
+                kick_spins(w, t, mi, k);
                 _mm512_storeu_pd(t.add(k), _mm512_setzero_pd());
             }
         }
         k += WIDTH;
     }
     (far != 0, out != 0)
+}
+
+/// `v += dtfm f` for the four grains whose (x, y) pairs start at number `o` of `v` and
+/// `f` (their factors `dtfm` in the lanes `idx` of `m8`, each twice); the new `v`.
+///
+/// SAFETY: `v` and `f` hold the numbers `o..o + 8`.
+#[inline(always)]
+unsafe fn kick_four(v: *mut f64, f: *const f64, m8: __m512d, idx: __m512i, o: usize) -> __m512d {
+    // SAFETY: see above.
+    unsafe {
+        let vv = _mm512_add_pd(_mm512_loadu_pd(v.add(o)), _mm512_mul_pd(_mm512_permutexvar_pd(idx, m8), _mm512_loadu_pd(f.add(o))));
+        _mm512_storeu_pd(v.add(o), vv);
+        vv
+    }
+}
+
+/// `w += dtfi M` for the eight grains from `k`.
+///
+/// SAFETY: `w`, `t` and `mi` hold the grains `k..k + 8`.
+#[inline(always)]
+unsafe fn kick_spins(w: *mut f64, t: *const f64, mi: *const f64, k: usize) {
+    // SAFETY: see above.
+    unsafe { _mm512_storeu_pd(w.add(k), _mm512_add_pd(_mm512_loadu_pd(w.add(k)), _mm512_mul_pd(_mm512_loadu_pd(mi.add(k)), _mm512_loadu_pd(t.add(k))))) };
 }
 
 /// The second half kick of the grains `0..8 m` of a part, as
@@ -248,13 +267,10 @@ unsafe fn kick_eights<const ROT: bool>(end: usize, g: GrainPart<'_>) {
         unsafe {
             let m8 = _mm512_loadu_pd(m.add(k));
             for (h, idx) in [(0, lo), (1, hi)] {
-                let o = 2 * k + 8 * h;
-                let vv = _mm512_add_pd(_mm512_loadu_pd(v.add(o)), _mm512_mul_pd(_mm512_permutexvar_pd(idx, m8), _mm512_loadu_pd(f.add(o))));
-                _mm512_storeu_pd(v.add(o), vv);
+                kick_four(v, f, m8, idx, 2 * k + 8 * h);
             }
             if ROT {
-                let ww = _mm512_add_pd(_mm512_loadu_pd(w.add(k)), _mm512_mul_pd(_mm512_loadu_pd(mi.add(k)), _mm512_loadu_pd(t.add(k))));
-                _mm512_storeu_pd(w.add(k), ww);
+                kick_spins(w, t, mi, k);
             }
         }
         k += WIDTH;
