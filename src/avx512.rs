@@ -1,4 +1,5 @@
-//! The contact sweep on CPUs with AVX-512: eight listed pairs per instruction.
+//! The contact sweep and the integrator on CPUs with AVX-512: eight pairs or grains per
+//! instruction.
 //!
 //! The sweep ([`crate::pipeline::sort_pairs`]) reads every pair of the Verlet list at
 //! every step to find the few that touch; at 5000 grains it was about 40% of the contact
@@ -12,9 +13,15 @@
 //! The arithmetic is the portable sweep's, operation for operation (the minimum image
 //! with [`crate::boundary::nearest_integer`]'s two additions, `dx dx + dy dy`, no fused
 //! multiply-add), so the lists and separations are the same bits; the unit test below
-//! checks it against the portable sweep. Compiled only when the build targets AVX-512
-//! (the default `-C target-cpu=native` on a machine that has it, `.cargo/config.toml`);
-//! otherwise the portable sweep does all of it.
+//! checks it against the portable sweep.
+//!
+//! The drift and the kicks of the integrator ([`drift`], [`kick`]) take eight grains at a
+//! time here too, on their (x, y) pairs as they are stored, with the skin watch and the
+//! periodic check in the same pass; the same operations as the portable loops, so the
+//! same bits (a unit test below).
+//!
+//! Compiled only when the build targets AVX-512 (the default `-C target-cpu=native` on a
+//! machine that has it, `.cargo/config.toml`); otherwise the portable code does all of it.
 
 use std::arch::x86_64::*;
 use std::ops::Range;
