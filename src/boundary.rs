@@ -45,11 +45,13 @@ impl Boundary {
         if !self.is_periodic() {
             return false;
         }
-        let (lo, period) = (self.x_min, self.period);
-        x.iter().fold(false, |out, x| {
-            let xr = x.x - lo;
-            out | !(xr >= 0.0 && xr < period)
-        })
+        x.iter().fold(false, |out, x| out | self.beyond(x.x - self.x_min))
+    }
+    /// Whether a position `xr` from the left edge of the periodic cell is not in
+    /// [0, period) (true for every non-zero `xr` without periodicity).
+    #[inline(always)]
+    fn beyond(&self, xr: f64) -> bool {
+        !(xr >= 0.0 && xr < self.period)
     }
     /// Bring a position back into [x_min, x_min + period).
     #[inline(always)]
@@ -61,7 +63,7 @@ impl Boundary {
         // Inside already (almost always), the position keeps its bits. A select, not a
         // branch around a store: the drift loop vectorises with a blend (with AVX-512 the
         // conditional store compiled to a masked scatter, four grains at a time).
-        let outside = self.period > 0.0 && !(xr >= 0.0 && xr < self.period);
+        let outside = self.period > 0.0 && self.beyond(xr);
         x.x = if outside { x.x - s * self.period } else { x.x };
     }
 }
