@@ -1,4 +1,4 @@
-//! The command line: `grainlab run|explain|scenes`.
+//! The command line: `grainlab run|explain|scenes|...` (`grainlab --help` lists them all).
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -33,6 +33,14 @@ enum Command {
         /// bit-identical to one thread.
         #[arg(long, default_value_t = 1)]
         threads: usize,
+    },
+    /// Time the thread pool's hand-over with no work (feature `parallel`): the fixed cost
+    /// of every stage on several threads, on this host now. Prints JSON, nanoseconds.
+    Handover {
+        #[arg(long, default_value_t = 2)]
+        threads: usize,
+        #[arg(long, default_value_t = 20000)]
+        samples: usize,
     },
     /// Print the step pipeline of a scene in one line, with dt and steps per contact.
     Explain { scene: String },
@@ -125,6 +133,10 @@ fn execute(cli: Cli) -> Result<(), Error> {
                 eprintln!("wrote {}", dir.display());
             }
             let _ = run_scene;
+            Ok(())
+        }
+        Command::Handover { threads, samples } => {
+            println!("{}", serde_json::to_string_pretty(&grainlab::threads::hand_over_summary(threads, samples)?).expect("numbers serialise"));
             Ok(())
         }
         Command::Explain { scene } => {

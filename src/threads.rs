@@ -14,6 +14,39 @@
 //! counter for about a millisecond before they park, and a hand-over costs well under a
 //! microsecond while the run is stepping.
 
+/// What `grainlab handover` reports: a hand-over's time with no work, ns.
+#[derive(Debug, serde::Serialize)]
+pub struct HandOver {
+    pub threads: usize,
+    pub samples: usize,
+    pub p10_ns: f64,
+    pub median_ns: f64,
+    pub p90_ns: f64,
+}
+
+/// [`Threads::hand_over_ns`] on a pool of `threads` (at least 2; feature `parallel`),
+/// `samples` times (at least 1), summarised.
+pub fn hand_over_summary(threads: usize, samples: usize) -> Result<HandOver, crate::error::Error> {
+    use crate::error::Error;
+    if !cfg!(feature = "parallel") {
+        return Err(Error::Invalid { field: "--threads".into(), value: threads.to_string(), allowed: "none: this build has no `parallel` feature (cargo build --release --features parallel)".into() });
+    }
+    if threads < 2 {
+        return Err(Error::Invalid { field: "--threads".into(), value: threads.to_string(), allowed: ">= 2".into() });
+    }
+    if samples == 0 {
+        return Err(Error::Invalid { field: "--samples".into(), value: "0".into(), allowed: ">= 1".into() });
+    }
+    #[cfg(feature = "parallel")]
+    let pool = Threads::new(threads)?;
+    #[cfg(not(feature = "parallel"))]
+    let pool = Threads::serial();
+    let mut t = pool.hand_over_ns(samples);
+    t.sort_by(f64::total_cmp);
+    let at = |q: f64| t[((t.len() - 1) as f64 * q).round() as usize];
+    Ok(HandOver { threads, samples, p10_ns: at(0.1), median_ns: at(0.5), p90_ns: at(0.9) })
+}
+
 /// Arrays (or tuples of them) that split at an index into two disjoint parts.
 pub trait Split: Sized + Send {
     fn split_at(self, mid: usize) -> (Self, Self);
@@ -108,6 +141,19 @@ impl Threads {
     pub fn bounds(&self, n: usize) -> Vec<usize> {
         let t = self.count();
         (0..=t).map(|r| r * n / t).collect()
+    }
+
+    /// How long `samples` hand-overs with no work take, each to every thread and back, in
+    /// nanoseconds: the fixed cost every stage on the pool pays. It follows the host's
+    /// core-to-core latency, which on shared virtual machines is not a constant.
+    pub fn hand_over_ns(&self, samples: usize) -> Vec<f64> {
+        (0..samples)
+            .map(|_| {
+                let t0 = std::time::Instant::now();
+                self.each((0..self.count()).map(|_| ()).collect(), |_, ()| {});
+                t0.elapsed().as_secs_f64() * 1e9
+            })
+            .collect()
     }
 
     /// `f(r, parts[r])` on thread r, for every r (one part per thread); returns when all

@@ -69,3 +69,20 @@ fn the_pool_gives_every_grain_once_keeps_parts_on_their_threads_and_passes_panic
     t.split(v.len(), &mut v[..], |part| part.iter_mut().for_each(|x| *x += 1));
     assert!(v.iter().all(|&x| x == 2001));
 }
+
+#[test]
+fn the_hand_over_probe_times_every_sample_and_checks_its_input() {
+    use grainlab::threads::hand_over_summary;
+    let h = hand_over_summary(2, 500).unwrap();
+    assert_eq!((h.threads, h.samples), (2, 500));
+    // Ordered quantiles of positive times. A hand-over with no work is a store and a spin
+    // each way (well under a microsecond on an idle host); 1 ms would mean the workers had
+    // parked between samples, which the pool's spin-wait exists to avoid. The bound is wide
+    // because the test machines are shared.
+    assert!(0.0 < h.p10_ns && h.p10_ns <= h.median_ns && h.median_ns <= h.p90_ns, "{h:?}");
+    assert!(h.median_ns < 1e6, "{h:?}");
+    for (threads, samples, field) in [(1, 10, "--threads"), (2, 0, "--samples")] {
+        let e = hand_over_summary(threads, samples).unwrap_err().to_string();
+        assert!(e.contains(field), "{e}");
+    }
+}
