@@ -150,7 +150,7 @@ impl Threads {
         (0..samples)
             .map(|_| {
                 let t0 = std::time::Instant::now();
-                self.each((0..self.count()).map(|_| ()).collect(), |_, ()| {});
+                self.each(vec![(); self.count()], |_, ()| {});
                 t0.elapsed().as_secs_f64() * 1e9
             })
             .collect()
