@@ -161,16 +161,7 @@ pub fn build(scene: &Scene) -> Result<Built, Error> {
 /// Build with the contact forces on `threads` threads (feature `parallel`; results are
 /// bit-identical to one thread).
 pub fn build_with(scene: &Scene, threads: usize) -> Result<Built, Error> {
-    if threads > 1 && !cfg!(feature = "parallel") {
-        return Err(Error::Invalid {
-            field: "--threads".into(),
-            value: threads.to_string(),
-            allowed: "1 (this build has no `parallel` feature: cargo build --release --features parallel)".into(),
-        });
-    }
-    if threads == 0 {
-        return Err(Error::Invalid { field: "--threads".into(), value: "0".into(), allowed: ">= 1".into() });
-    }
+    crate::threads::Threads::check_count(threads, 1)?;
     scene.validate()?;
     let shape = scene.grain_shape;
     let mats = &scene.materials;
@@ -306,10 +297,7 @@ pub fn build_with(scene: &Scene, threads: usize) -> Result<Built, Error> {
     let skin = scene.neighbor.skin * 2.0 * p.r[..n_free].iter().cloned().fold(f64::INFINITY, f64::min);
     let options = ModelOptions { limit_force: scene.model.limit_force, lever_arm: scene.model.lever_arm };
     let all_elastic = mats.iter().all(|m| m.restitution == 1.0);
-    #[cfg(feature = "parallel")]
     let threads = crate::threads::Threads::new(threads)?;
-    #[cfg(not(feature = "parallel"))]
-    let threads = crate::threads::Threads::serial();
     let parts = Parts { p, boundary, walls, wall_material, dt: time_step.dt_s, skin, scene, threads };
     let engine: Box<dyn Engine> = match (scene.model.tangential, all_elastic) {
         (TangentialSpec::Frictionless, false) => parts.assemble(HertzFrictionless::new(options))?,

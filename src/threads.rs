@@ -27,20 +27,11 @@ pub struct HandOver {
 /// [`Threads::hand_over_ns`] on a pool of `threads` (at least 2; feature `parallel`),
 /// `samples` times (at least 1), summarised.
 pub fn hand_over_summary(threads: usize, samples: usize) -> Result<HandOver, crate::error::Error> {
-    use crate::error::Error;
-    if !cfg!(feature = "parallel") {
-        return Err(Error::Invalid { field: "--threads".into(), value: threads.to_string(), allowed: "none: this build has no `parallel` feature (cargo build --release --features parallel)".into() });
-    }
-    if threads < 2 {
-        return Err(Error::Invalid { field: "--threads".into(), value: threads.to_string(), allowed: ">= 2".into() });
-    }
+    Threads::check_count(threads, 2)?;
     if samples == 0 {
-        return Err(Error::Invalid { field: "--samples".into(), value: "0".into(), allowed: ">= 1".into() });
+        return Err(crate::error::Error::Invalid { field: "--samples".into(), value: "0".into(), allowed: ">= 1".into() });
     }
-    #[cfg(feature = "parallel")]
     let pool = Threads::new(threads)?;
-    #[cfg(not(feature = "parallel"))]
-    let pool = Threads::serial();
     let mut t = pool.hand_over_ns(samples);
     t.sort_by(f64::total_cmp);
     let at = |q: f64| t[((t.len() - 1) as f64 * q).round() as usize];
@@ -97,14 +88,30 @@ impl Threads {
         Threads::default()
     }
 
-    /// The calling thread and `n - 1` more (one thread: none).
-    #[cfg(feature = "parallel")]
-    pub fn new(n: usize) -> Result<Self, crate::error::Error> {
-        if n <= 1 {
-            return Ok(Threads::serial());
+    /// A requested number of threads `n` (the `--threads` option) against what this build
+    /// allows: at least `min`, and more than one only with the `parallel` feature.
+    pub fn check_count(n: usize, min: usize) -> Result<(), crate::error::Error> {
+        let invalid = |allowed: String| Err(crate::error::Error::Invalid { field: "--threads".into(), value: n.to_string(), allowed });
+        if n > 1 && !cfg!(feature = "parallel") {
+            let only = if min <= 1 { "1" } else { "none" };
+            return invalid(format!("{only} (this build has no `parallel` feature: cargo build --release --features parallel)"));
         }
-        let pool = pool::SpinPool::new(n).map_err(|e| crate::error::Error::Other(format!("starting {n} threads: {e}")))?;
-        Ok(Threads { pool: Some(std::sync::Arc::new(pool)) })
+        if n < min {
+            return invalid(format!(">= {min}"));
+        }
+        Ok(())
+    }
+
+    /// The calling thread and `n - 1` more (one thread: none); `n` as [`Threads::check_count`]
+    /// allows with a minimum of 1.
+    pub fn new(n: usize) -> Result<Self, crate::error::Error> {
+        Threads::check_count(n, 1)?;
+        #[cfg(feature = "parallel")]
+        if n > 1 {
+            let pool = pool::SpinPool::new(n).map_err(|e| crate::error::Error::Other(format!("starting {n} threads: {e}")))?;
+            return Ok(Threads { pool: Some(std::sync::Arc::new(pool)) });
+        }
+        Ok(Threads::serial())
     }
 
     /// Number of threads.

@@ -133,3 +133,22 @@ fn export_refuses_what_the_reference_code_cannot_express() {
         .stderr(predicate::str::contains("restitution"));
     assert!(!out.exists());
 }
+
+/// A thread count this build cannot give is refused up front, naming `--threads` and what
+/// it allows: 0 for a run, 1 for the hand-over probe (which needs two threads), and more
+/// than 1 in a build without the `parallel` feature (which this test build is, unless
+/// the suite runs with `--features parallel`).
+#[test]
+fn thread_counts_this_build_cannot_give_are_refused_with_the_range() {
+    let mut cases = vec![(vec!["run", "shear", "--threads", "0"], ">= 1"), (vec!["handover", "--threads", "1"], ">= 2")];
+    if !cfg!(feature = "parallel") {
+        cases.push((vec!["run", "shear", "--threads", "2"], "1 (this build has no `parallel` feature"));
+        cases.push((vec!["handover", "--threads", "2"], "none (this build has no `parallel` feature"));
+    }
+    for (args, allowed) in cases {
+        let out = grainlab().args(&args).output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{args:?} ran");
+        assert!(err.contains("--threads") && err.contains(allowed), "{args:?}: {err}");
+    }
+}
