@@ -47,11 +47,16 @@ impl<L: ContactLaw> Stage<L> for MoveWalls {
             wall.y += d.y;
             wall.x_shift += d.x;
             if let Surface::Rough { grains } = &wall.surface {
-                for k in grains.clone() {
-                    w.p.x[k] += d;
-                    w.boundary.wrap(&mut w.p.x[k]);
-                    w.p.v[k] = wall.v;
+                // As slices, so that the loops vectorise; and the wrap (a chain of
+                // roundings per grain) only when a grain has left the cell, which leaves
+                // the same bits as wrapping every grain (`Boundary::wrap` keeps the bits
+                // of a grain inside).
+                let x = &mut w.p.x[grains.clone()];
+                x.iter_mut().for_each(|x| *x += d);
+                if w.boundary.any_outside(x) {
+                    x.iter_mut().for_each(|x| w.boundary.wrap(x));
                 }
+                w.p.v[grains.clone()].fill(wall.v);
                 let at = w.neighbours.at_build();
                 if at.len() == w.p.len() {
                     let far = Neighbours::moved(&w.p.x[grains.clone()], &at[grains.clone()], &w.boundary, w.neighbours.limit());
