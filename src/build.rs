@@ -199,9 +199,15 @@ pub fn build_with(scene: &Scene, threads: usize) -> Result<Built, Error> {
             let area: f64 = radii.iter().map(|r| std::f64::consts::PI * r * r).sum();
             let lx = spec.x[1] - spec.x[0];
             let h = area / (spec.packing_fraction * lx);
+            let r_max = radii.iter().cloned().fold(0.0, f64::max);
+            // Too few grains to fill the x range one grain high at this packing fraction.
+            if h < 2.0 * r_max {
+                let need = (2.0 * r_max * spec.packing_fraction * lx / (area / spec.count as f64)).ceil();
+                let allowed = format!(">= about {need} (to fill x = [{}, {}] m at packing_fraction {} at least one grain diameter high)", spec.x[0], spec.x[1], spec.packing_fraction);
+                return Err(Error::Invalid { field: "grains.pack.count".into(), value: spec.count.to_string(), allowed });
+            }
             let centres = relaxed_packing(&radii, spec.x[0], spec.x[1], y0, y0 + h, boundary.is_periodic(), spec.seed);
             // A packing's order is arbitrary: store it along a space-filling curve.
-            let r_max = radii.iter().cloned().fold(0.0, f64::max);
             for k in crate::pack::morton_order(&centres, spec.x[0], y0, 2.0 * r_max) {
                 push(&mut p, centres[k], Vec2::zeros(), 0.0, radii[k], spec.material);
             }

@@ -94,6 +94,24 @@ fn bad_scenes_are_refused_with_the_field_and_the_range() {
     refused(|s| s["colour"] = "red".into(), "unknown field `colour`", "expected one of");
 }
 
+/// A pack with too few grains to fill its x range one grain high is refused with the
+/// count it needs (it had panicked inside the packing).
+#[test]
+fn a_pack_lower_than_a_grain_is_refused_with_the_count_it_needs() {
+    let mut s = builtin_json("shear");
+    s["grains"]["pack"]["count"] = 1.into();
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("one.json");
+    std::fs::write(&file, serde_json::to_string(&s).unwrap()).unwrap();
+    let out = dir.path().join("out");
+    grainlab()
+        .args(["run", file.to_str().unwrap(), "--quiet", "--out", out.to_str().unwrap()])
+        .assert()
+        .failure()
+        .stderr(predicate::str::contains("grains.pack.count = 1").and(predicate::str::contains(">= ")).and(predicate::str::contains("one grain diameter high")));
+    assert!(!out.exists());
+}
+
 #[test]
 fn an_unknown_scene_lists_the_builtins() {
     grainlab().args(["run", "no-such-scene", "--quiet"]).assert().failure().stderr(predicate::str::contains("collision, oblique, shear"));
