@@ -258,6 +258,26 @@ pub fn brute_force_pairs(x: &[Vec2], r: &[f64], n_free: usize, boundary: &Bounda
     out
 }
 
+/// Counting sort of grains into cells: grain i is in cell `cells[i]` (of `ncell`); the
+/// grains of cell c are `cell_items[cell_start[c]..cell_start[c + 1]]`, in index order.
+pub fn bin_into_cells(cells: &[u32], ncell: usize, cell_start: &mut Vec<u32>, cell_items: &mut Vec<u32>) {
+    cell_start.clear();
+    cell_start.resize(ncell + 1, 0);
+    for &c in cells {
+        cell_start[c as usize + 1] += 1;
+    }
+    for c in 0..ncell {
+        cell_start[c + 1] += cell_start[c];
+    }
+    cell_items.clear();
+    cell_items.resize(cells.len(), 0);
+    let mut fill = cell_start[..ncell].to_vec();
+    for (i, &c) in cells.iter().enumerate() {
+        cell_items[fill[c as usize] as usize] = i as u32;
+        fill[c as usize] += 1;
+    }
+}
+
 /// All pairs closer than the skin, with a cell list. Sorted, i < j. Each of `threads`
 /// lists the pairs (i, j > i) of its own grains i, already in order, so the parts join
 /// into the sorted list with no sort.
@@ -310,24 +330,8 @@ pub fn cell_pairs(
         let cy = (((p.y - lo.y) / wy).max(0.0) as usize).min(ny - 1);
         cy * nx + cx
     };
-    // Counting sort of grains into cells.
-    let ncell = nx * ny;
-    cell_start.clear();
-    cell_start.resize(ncell + 1, 0);
     let cells: Vec<u32> = x.iter().map(|p| cell_of(p) as u32).collect();
-    for &c in &cells {
-        cell_start[c as usize + 1] += 1;
-    }
-    for c in 0..ncell {
-        cell_start[c + 1] += cell_start[c];
-    }
-    cell_items.clear();
-    cell_items.resize(n, 0);
-    let mut fill = cell_start[..ncell].to_vec();
-    for (i, &c) in cells.iter().enumerate() {
-        cell_items[fill[c as usize] as usize] = i as u32;
-        fill[c as usize] += 1;
-    }
+    bin_into_cells(&cells, nx * ny, cell_start, cell_items);
     let (cell_start, cell_items) = (&cell_start[..], &cell_items[..]);
     // Each grain with the grains of higher index in its cell and the eight around it.
     let pairs_of = |i: usize, out: &mut Vec<[u32; 2]>| {

@@ -13,7 +13,7 @@ use serde::{Deserialize, Serialize};
 use crate::boundary::Boundary;
 use crate::dim::Vec2;
 use crate::error::{Error, check};
-use crate::neighbor::Neighbours;
+use crate::neighbor::{Neighbours, bin_into_cells};
 
 /// A distribution of radii, m. Normal and lognormal draws are truncated to [min, max].
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -266,7 +266,7 @@ impl Grid {
 struct Partners {
     start: Vec<usize>,
     list: Vec<u32>,
-    cell_start: Vec<usize>,
+    cell_start: Vec<u32>,
     cell_items: Vec<u32>,
 }
 
@@ -277,32 +277,18 @@ impl Partners {
 
     /// Every pair of grains closer than the sum of their radii plus `skin` (minimum image).
     fn find(&mut self, grid: &Grid, x: &[Vec2], r: &[f64], index: &[u32], boundary: &Boundary, skin: f64) {
-        let cells: Vec<usize> = x.iter().map(|p| grid.cell(p)).map(|(cx, cy)| cy * grid.nx + cx).collect();
-        let ncell = grid.nx * grid.ny;
-        self.cell_start.clear();
-        self.cell_start.resize(ncell + 1, 0);
-        for &c in &cells {
-            self.cell_start[c + 1] += 1;
-        }
-        for c in 0..ncell {
-            self.cell_start[c + 1] += self.cell_start[c];
-        }
-        let mut fill = self.cell_start[..ncell].to_vec();
-        self.cell_items.clear();
-        self.cell_items.resize(x.len(), 0);
-        for (g, &c) in cells.iter().enumerate() {
-            self.cell_items[fill[c]] = g as u32;
-            fill[c] += 1;
-        }
+        let cells: Vec<u32> = x.iter().map(|p| grid.cell(p)).map(|(cx, cy)| (cy * grid.nx + cx) as u32).collect();
+        bin_into_cells(&cells, grid.nx * grid.ny, &mut self.cell_start, &mut self.cell_items);
         self.start.clear();
         self.list.clear();
         self.start.push(0);
         let mut around = [0; 9];
         for (g, &c) in cells.iter().enumerate() {
             let from = self.list.len();
+            let c = c as usize;
             let m = grid.around(c % grid.nx, c / grid.nx, &mut around);
             for &d in &around[..m] {
-                for &q in &self.cell_items[self.cell_start[d]..self.cell_start[d + 1]] {
+                for &q in &self.cell_items[self.cell_start[d] as usize..self.cell_start[d + 1] as usize] {
                     let q = q as usize;
                     let reach = r[g] + r[q] + skin;
                     if q != g && boundary.image(x[g] - x[q]).norm_squared() < reach * reach {

@@ -67,7 +67,12 @@ fn shear_run_writes_wall_stresses_and_paraview_frames() {
 /// A collision scene with one field changed must be refused: non-zero exit, a message
 /// naming the field, the value and the range, and no output directory.
 fn refused(change: impl Fn(&mut Value), field: &str, range: &str) {
-    let mut s = builtin_json("collision");
+    refused_scene("collision", change, field, range);
+}
+
+/// [`refused`] for the built-in scene `name`.
+fn refused_scene(name: &str, change: impl Fn(&mut Value), field: &str, range: &str) {
+    let mut s = builtin_json(name);
     change(&mut s);
     let dir = tempfile::tempdir().unwrap();
     let file = dir.path().join("bad.json");
@@ -98,18 +103,8 @@ fn bad_scenes_are_refused_with_the_field_and_the_range() {
 /// count it needs (it had panicked inside the packing).
 #[test]
 fn a_pack_lower_than_a_grain_is_refused_with_the_count_it_needs() {
-    let mut s = builtin_json("shear");
-    s["grains"]["pack"]["count"] = 1.into();
-    let dir = tempfile::tempdir().unwrap();
-    let file = dir.path().join("one.json");
-    std::fs::write(&file, serde_json::to_string(&s).unwrap()).unwrap();
-    let out = dir.path().join("out");
-    grainlab()
-        .args(["run", file.to_str().unwrap(), "--quiet", "--out", out.to_str().unwrap()])
-        .assert()
-        .failure()
-        .stderr(predicate::str::contains("grains.pack.count = 1").and(predicate::str::contains(">= ")).and(predicate::str::contains("one grain diameter high")));
-    assert!(!out.exists());
+    let range = ">= about 40 (to fill x = [0, 0.04] m at packing_fraction 0.75 at least one grain diameter high)";
+    refused_scene("shear", |s| s["grains"]["pack"]["count"] = 1.into(), "grains.pack.count = 1", range);
 }
 
 #[test]
