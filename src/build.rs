@@ -381,13 +381,14 @@ impl Parts<'_> {
             Ok(s)
         };
         let mut stages: Vec<Box<dyn Stage<L<Dm, T>>>> = Vec::new();
+        // The walls first: their grains follow them in the drift.
+        if has_walls {
+            stages.push(Box::new(MoveWalls));
+        }
         if rotation {
             stages.push(Box::new(InitialIntegrate::<true>::default()));
         } else {
             stages.push(Box::new(InitialIntegrate::<false>::default()));
-        }
-        if has_walls {
-            stages.push(Box::new(MoveWalls));
         }
         stages.extend(forces()?);
         if has_walls {

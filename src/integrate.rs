@@ -14,6 +14,7 @@ use crate::error::Error;
 use crate::particles::Particles;
 use crate::pipeline::Stage;
 use crate::sim::World;
+use crate::walls::Glued;
 
 /// The half-kick factors `dt/2 / m` and `dt/2 / I` of the free grains, divided out once
 /// per time step value instead of at every step (the same division, so the same bits as
@@ -46,10 +47,17 @@ impl KickFactors {
 /// than half the skin since the last build?): with AVX-512 in the same pass. The forces
 /// (and torques) it has used are set to zero there ([`World::zeroed`]): the step's
 /// contact stage adds the new ones, and `ClearForces` need not pass over them again.
+///
+/// The rough walls' grains follow their walls in the same pass ([`Glued::follow`]; the
+/// walls themselves have moved in [`crate::pipeline::MoveWalls`] just before), on the
+/// thread that owns them in the contact stage: its cache has them, and a serial stage
+/// would have to fetch them from there.
 #[derive(Default)]
 pub struct InitialIntegrate<const ROT: bool> {
     /// Stands in for the positions at the last build before there is a build.
     origin: Vec<Vec2>,
+    /// The rough walls' grains and their moves this step.
+    glued: Vec<Glued>,
 }
 
 impl<L: ContactLaw, const ROT: bool> Stage<L> for InitialIntegrate<ROT> {
@@ -59,20 +67,30 @@ impl<L: ContactLaw, const ROT: bool> Stage<L> for InitialIntegrate<ROT> {
     fn run(&mut self, w: &mut World<L>) -> Result<(), Error> {
         let dt = w.dt;
         let p = &mut w.p;
-        let n = p.n_free;
+        let (n, n_free) = (p.len(), p.n_free);
         let k = &mut w.kick;
         k.update(p, dt);
         let (b, limit) = (w.boundary, w.neighbours.limit());
-        let listed = w.neighbours.at_build().len() == p.len();
+        let listed = w.neighbours.at_build().len() == n;
         if !listed {
             // No list yet: the next stage builds one whatever this pass finds.
             self.origin.resize(n, Vec2::zeros());
         }
-        let at = if listed { &w.neighbours.at_build()[..n] } else { &self.origin[..] };
+        let at = if listed { w.neighbours.at_build() } else { &self.origin[..] };
+        self.glued.clear();
+        self.glued.extend(w.walls.iter().filter_map(|wall| Glued::of(wall, dt)));
+        let glued = &self.glued;
         let far = AtomicBool::new(false);
-        let translation = (&mut p.v[..n], &mut p.x[..n], &mut p.f[..n], &k.dtfm[..], at);
-        let rotation = (&mut p.omega[..n], &mut p.torque[..n], &k.dtfi[..]);
-        w.threads.split(n, (translation, rotation), |((v, x, f, dtfm, at), (omega, torque, dtfi))| {
+        let translation = (&mut p.v[..], &mut p.x[..], &mut p.f[..], at, &k.dtfm[..]);
+        let rotation = (&mut p.torque[..], &mut p.omega[..n_free], &k.dtfi[..]);
+        w.threads.split_free(n_free, n, (translation, rotation), |range, ((v, x, f, at, dtfm), (torque, omega, dtfi))| {
+            // The free grains of this part, then the glued ones.
+            let nf = dtfm.len();
+            let (v, vg) = v.split_at_mut(nf);
+            let (x, xg) = x.split_at_mut(nf);
+            let (f, fg) = f.split_at_mut(nf);
+            let (torque, tg) = torque.split_at_mut(nf);
+            let (at, atg) = at.split_at(nf);
             // Where the build has AVX-512, eight grains at a time first (the same bits).
             #[cfg(all(target_arch = "x86_64", target_feature = "avx512f", target_feature = "avx512vl", target_feature = "avx512bw"))]
             let (from, mut far_here, out) = {
@@ -100,7 +118,21 @@ impl<L: ContactLaw, const ROT: bool> Stage<L> for InitialIntegrate<ROT> {
                 x.iter_mut().for_each(|x| b.wrap(x));
                 (far_here, watch) = (false, 0);
             }
-            if far_here || Neighbours::moved(&x[watch..], &at[watch..], &b, limit) {
+            far_here = far_here || Neighbours::moved(&x[watch..], &at[watch..], &b, limit);
+            // The glued grains: their forces are cleared here too.
+            let g0 = range.start + nf;
+            for g in glued {
+                let (lo, hi) = (g.grains.start.max(g0), g.grains.end.min(range.end));
+                if lo < hi {
+                    let part = lo - g0..hi - g0;
+                    far_here |= g.follow(&mut xg[part.clone()], &mut vg[part.clone()], &atg[part], &b, limit);
+                }
+            }
+            fg.fill(Vec2::zeros());
+            if ROT {
+                tg.fill(0.0);
+            }
+            if far_here {
                 far.store(true, Ordering::Relaxed);
             }
         });

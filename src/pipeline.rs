@@ -15,7 +15,7 @@ use crate::contact::{ContactInput, ContactLaw, ContactModel, EnergyMemory, Energ
 use crate::dim::{Vec2, cross};
 use crate::lanes::{LANES, Lanes, Real, gather, gather2, lane2};
 use crate::material::PairMaterial;
-use crate::neighbor::{CheckedPairs, Neighbours, PairConst};
+use crate::neighbor::{CheckedPairs, PairConst};
 use crate::observe::energy::EnergyLedger;
 use crate::particles::Particles;
 use crate::error::Error;
@@ -29,8 +29,8 @@ pub trait Stage<L: ContactLaw>: Send {
 }
 
 /// Move the walls: prescribed x velocity, and for a loaded wall the first half kick and
-/// drift in y; glued grains follow their wall (wrapped into the periodic cell, and
-/// watched for the neighbour list's skin).
+/// drift in y. Their glued grains follow in the drift that comes next
+/// ([`crate::walls::Glued`], in [`crate::integrate::InitialIntegrate`]), on the thread that owns them.
 pub struct MoveWalls;
 
 impl<L: ContactLaw> Stage<L> for MoveWalls {
@@ -46,23 +46,6 @@ impl<L: ContactLaw> Stage<L> for MoveWalls {
             let d = wall.v * dt;
             wall.y += d.y;
             wall.x_shift += d.x;
-            if let Surface::Rough { grains } = &wall.surface {
-                // As slices, so that the loops vectorise; and the wrap (a chain of
-                // roundings per grain) only when a grain has left the cell, which leaves
-                // the same bits as wrapping every grain (`Boundary::wrap` keeps the bits
-                // of a grain inside).
-                let x = &mut w.p.x[grains.clone()];
-                x.iter_mut().for_each(|x| *x += d);
-                if w.boundary.any_outside(x) {
-                    x.iter_mut().for_each(|x| w.boundary.wrap(x));
-                }
-                w.p.v[grains.clone()].fill(wall.v);
-                let at = w.neighbours.at_build();
-                if at.len() == w.p.len() {
-                    let far = Neighbours::moved(&w.p.x[grains.clone()], &at[grains.clone()], &w.boundary, w.neighbours.limit());
-                    w.neighbours.moved_far |= far;
-                }
-            }
         }
         Ok(())
     }

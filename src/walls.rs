@@ -69,3 +69,40 @@ impl Wall {
         self.surface == Surface::Flat
     }
 }
+
+/// A rough wall's grains and their rigid move this step.
+pub struct Glued {
+    /// The grains (indices into the particle arrays).
+    pub grains: std::ops::Range<usize>,
+    /// Displacement this step, m.
+    pub d: Vec2,
+    /// Velocity, m/s.
+    pub v: Vec2,
+}
+
+impl Glued {
+    /// The grains of `wall` if it is rough, and its move over `dt` at its velocity now (the
+    /// product [`crate::pipeline::MoveWalls`] moved the wall by, so the grains keep their
+    /// place on it to the bit).
+    pub fn of(wall: &Wall, dt: f64) -> Option<Glued> {
+        match &wall.surface {
+            Surface::Rough { grains } => Some(Glued { grains: grains.clone(), d: wall.v * dt, v: wall.v }),
+            Surface::Flat => None,
+        }
+    }
+
+    /// Move grains `x` (some of this wall's, with their velocities `v` and positions `at`
+    /// at the neighbour list's build) with the wall, back into the periodic cell; whether
+    /// one has moved more than `limit` (squared) since the build.
+    pub fn follow(&self, x: &mut [Vec2], v: &mut [Vec2], at: &[Vec2], b: &crate::boundary::Boundary, limit: f64) -> bool {
+        // As slices, so that the loops vectorise; and the wrap (a chain of roundings per
+        // grain) only when a grain has left the cell, which leaves the same bits as
+        // wrapping every grain (`Boundary::wrap` keeps the bits of a grain inside).
+        x.iter_mut().for_each(|x| *x += self.d);
+        if b.any_outside(x) {
+            x.iter_mut().for_each(|x| b.wrap(x));
+        }
+        v.fill(self.v);
+        crate::neighbor::Neighbours::moved(x, at, b, limit)
+    }
+}

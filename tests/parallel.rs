@@ -68,6 +68,24 @@ fn the_pool_gives_every_grain_once_keeps_parts_on_their_threads_and_passes_panic
     }
     t.split(v.len(), &mut v[..], |part| part.iter_mut().for_each(|x| *x += 1));
     assert!(v.iter().all(|&x| x == 2001));
+    // The drift's split: equal shares of all grains, the last thread taking every grain
+    // from n_free on (the rough walls' grains it owns in the contact stage), and arrays of
+    // the free grains only cut alike. Each part is told where it is.
+    for (n_free, want) in [(7_000, [0..5_000, 5_000..10_000]), (3_000, [0..3_000, 3_000..10_000])] {
+        let mut all = vec![0u32; 10_000];
+        let mut free = vec![0u32; n_free];
+        let ranges = Mutex::new(Vec::new());
+        t.split_free(n_free, all.len(), (&mut all[..], &mut free[..]), |range, (all, free)| {
+            assert_eq!(all.len(), range.len());
+            assert_eq!(free.len(), range.end.min(n_free) - range.start.min(n_free));
+            all.iter_mut().chain(free.iter_mut()).for_each(|x| *x += 1);
+            ranges.lock().unwrap().push(range);
+        });
+        let mut ranges = ranges.into_inner().unwrap();
+        ranges.sort_by_key(|r| r.start);
+        assert_eq!(ranges, want, "{n_free} free grains");
+        assert!(all.iter().chain(&free).all(|&x| x == 1), "each grain once");
+    }
 }
 
 #[test]
