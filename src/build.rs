@@ -24,6 +24,9 @@ use crate::walls::{Control, Surface, Wall};
 /// A running simulation behind one dynamic call per step, whatever its contact model.
 pub trait Engine: Send {
     fn step(&mut self) -> Result<(), Error>;
+    /// One step, after which nothing looks at the grains' velocities or spins (`look`
+    /// false) before the next: see [`Simulation::advance`].
+    fn advance(&mut self, look: bool) -> Result<(), Error>;
     fn particles(&self) -> &Particles;
     fn walls(&self) -> &[Wall];
     fn boundary(&self) -> Boundary;
@@ -47,6 +50,9 @@ pub trait Engine: Send {
 impl<L: ContactLaw> Engine for Simulation<L> {
     fn step(&mut self) -> Result<(), Error> {
         Simulation::step(self)
+    }
+    fn advance(&mut self, look: bool) -> Result<(), Error> {
+        Simulation::advance(self, look)
     }
     fn particles(&self) -> &Particles {
         &self.world.p

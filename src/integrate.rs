@@ -4,6 +4,11 @@
 //! forces at the new positions, then `v += dt/2 F/m`, `w += dt/2 M/I` (final half).
 //! The forces are therefore evaluated with the half-step velocities v(n+1/2), as in
 //! LIGGGHTS and YADE: that is the velocity the damping and the tangential increment see.
+//!
+//! The final half kick of a step and the first of the next use the same forces, so when
+//! nothing looks at the grains in between, the final one is left to the next drift
+//! ([`KickFactors::defer`]): one pass over the grains' arrays instead of two, and the same
+//! two roundings per grain (`v += dt/2 F/m` twice, never `v += dt F/m`), so the same bits.
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -25,8 +30,41 @@ pub struct KickFactors {
     dt: f64,
     /// dt/2 / m, s/kg.
     pub dtfm: Vec<f64>,
+    /// dt/2 / m twice per grain, s/kg: the factor of each component of a grain's
+    /// velocity, as the velocities are stored (x, y). A kick or drift over the
+    /// components is then element by element, which compilers vectorise without
+    /// splitting the (x, y) pairs into an x and a y register and back.
+    pub dtfm2: Vec<Vec2>,
     /// dt/2 / I, s/(kg m^2).
     pub dtfi: Vec<f64>,
+    /// Leave this step's final half kick to the next drift: nothing looks at the grains'
+    /// velocities before it ([`crate::sim::Simulation::advance`] sets it).
+    pub defer: bool,
+    /// The final half kick left to the next drift, if any: for time step `dt`, s, and
+    /// with the spins (`spin`) or not. Until the drift (or [`settle`]) gives it, the free
+    /// grains' velocities and spins are half a kick behind.
+    pub pending: Option<PendingKick>,
+}
+
+/// A final half kick not given yet ([`KickFactors::pending`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PendingKick {
+    /// Time step of the step it ends, s.
+    pub dt: f64,
+    /// It kicks the spins too.
+    pub spin: bool,
+}
+
+/// Give the final half kick left pending ([`KickFactors::pending`]), if any: the
+/// velocities and spins are then those of the end of the step.
+pub fn settle<L: ContactLaw>(w: &mut World<L>) {
+    if let Some(k) = w.kick.pending.take() {
+        if k.spin {
+            kick_free::<L, true>(w, k.dt);
+        } else {
+            kick_free::<L, false>(w, k.dt);
+        }
+    }
 }
 
 impl KickFactors {
@@ -37,6 +75,7 @@ impl KickFactors {
             let dtf = 0.5 * dt;
             self.dt = dt;
             self.dtfm = p.m[..n].iter().map(|m| dtf / m).collect();
+            self.dtfm2 = self.dtfm.iter().map(|&m| Vec2::new(m, m)).collect();
             self.dtfi = p.inertia[..n].iter().map(|i| dtf / i).collect();
         }
     }
@@ -66,6 +105,12 @@ impl<L: ContactLaw, const ROT: bool> Stage<L> for InitialIntegrate<ROT> {
     }
     fn run(&mut self, w: &mut World<L>) -> Result<(), Error> {
         let dt = w.dt;
+        // The last step's final half kick, if it was left to this pass (with the factors
+        // of this step, which it shares; else it is given on its own first).
+        if w.kick.pending.is_some_and(|k| k.dt != dt || k.spin != ROT) {
+            settle(w);
+        }
+        let twice = w.kick.pending.take().is_some();
         let p = &mut w.p;
         let (n, n_free) = (p.len(), p.n_free);
         let k = &mut w.kick;
@@ -81,9 +126,9 @@ impl<L: ContactLaw, const ROT: bool> Stage<L> for InitialIntegrate<ROT> {
         self.glued.extend(w.walls.iter().filter_map(|wall| Glued::of(wall, dt)));
         let glued = &self.glued;
         let far = AtomicBool::new(false);
-        let translation = (&mut p.v[..], &mut p.x[..], &mut p.f[..], at, &k.dtfm[..]);
+        let translation = (&mut p.v[..], &mut p.x[..], &mut p.f[..], at, (&k.dtfm[..], &k.dtfm2[..]));
         let rotation = (&mut p.torque[..], &mut p.omega[..n_free], &k.dtfi[..]);
-        w.threads.split_free(n_free, n, (translation, rotation), |range, ((v, x, f, at, dtfm), (torque, omega, dtfi))| {
+        w.threads.split_free(n_free, n, (translation, rotation), |range, ((v, x, f, at, (dtfm, dtfm2)), (torque, omega, dtfi))| {
             // The free grains of this part, then the glued ones.
             let nf = dtfm.len();
             let (v, vg) = v.split_at_mut(nf);
@@ -91,25 +136,25 @@ impl<L: ContactLaw, const ROT: bool> Stage<L> for InitialIntegrate<ROT> {
             let (f, fg) = f.split_at_mut(nf);
             let (torque, tg) = torque.split_at_mut(nf);
             let (at, atg) = at.split_at(nf);
-            // Where the build has AVX-512, eight grains at a time first (the same bits).
+            // Where the build has AVX-512, eight grains at a time first (the same bits),
+            // after the pending kick in a pass of its own.
             #[cfg(all(target_arch = "x86_64", target_feature = "avx512f", target_feature = "avx512vl", target_feature = "avx512bw"))]
-            let (from, mut far_here, out) = {
+            let (from, mut far_here, out, twice) = {
+                if twice {
+                    kick_part::<ROT>(&mut *v, &mut *f, (dtfm, dtfm2), &mut *omega, &mut *torque, dtfi);
+                }
                 let g = crate::avx512::GrainPart { v: &mut *v, f: &mut *f, dtfm, omega: &mut *omega, torque: &mut *torque, dtfi };
-                crate::avx512::drift::<ROT>(g, &mut *x, at, dt, &b, limit)
+                let (from, far, out) = crate::avx512::drift::<ROT>(g, &mut *x, at, dt, &b, limit);
+                (from, far, out, false)
             };
             #[cfg(not(all(target_arch = "x86_64", target_feature = "avx512f", target_feature = "avx512vl", target_feature = "avx512bw")))]
             let (from, mut far_here, out) = (0, false, false);
-            for (((v, x), f), m) in v[from..].iter_mut().zip(x[from..].iter_mut()).zip(&f[from..]).zip(&dtfm[from..]) {
-                *v += *m * *f;
-                *x += dt * *v;
-            }
-            // The forces (and torques) are used: zero for the step's contacts to add to.
-            f[from..].fill(Vec2::zeros());
-            if ROT {
-                for ((w, t), m) in omega[from..].iter_mut().zip(&torque[from..]).zip(&dtfi[from..]) {
-                    *w += *m * *t;
-                }
-                torque[from..].fill(0.0);
+            let part = (&mut v[from..], &mut x[from..], &mut f[from..], &dtfm2[from..]);
+            let spin = (&mut omega[from..], &mut torque[from..], &dtfi[from..]);
+            if twice {
+                drift_free::<ROT, true>(part, spin, dt);
+            } else {
+                drift_free::<ROT, false>(part, spin, dt);
             }
             // Back into the periodic cell: rarely anyone to bring back, so one check of
             // all first (the wrap itself is a chain of roundings per grain).
@@ -142,7 +187,75 @@ impl<L: ContactLaw, const ROT: bool> Stage<L> for InitialIntegrate<ROT> {
     }
 }
 
-/// Second half kick of the free grains.
+/// The first half kick (after the pending final one of the last step when `TWICE`) and
+/// the drift of free grains; their forces (and torques) are then used, and set to zero
+/// for the step's contacts to add to.
+#[inline(always)]
+fn drift_free<const ROT: bool, const TWICE: bool>((v, x, f, dtfm2): (&mut [Vec2], &mut [Vec2], &mut [Vec2], &[Vec2]), (omega, torque, dtfi): (&mut [f64], &mut [f64], &[f64]), dt: f64) {
+    // Component by component ([`KickFactors::dtfm2`]).
+    let (vc, xc, fc, mc) = (flat_mut(v), flat_mut(x), flat(f), flat(dtfm2));
+    for (((v, x), f), m) in vc.iter_mut().zip(xc.iter_mut()).zip(fc).zip(mc) {
+        if TWICE {
+            *v += *m * *f;
+        }
+        *v += *m * *f;
+        *x += dt * *v;
+    }
+    f.fill(Vec2::zeros());
+    if ROT {
+        for ((w, t), m) in omega.iter_mut().zip(&*torque).zip(dtfi) {
+            if TWICE {
+                *w += *m * *t;
+            }
+            *w += *m * *t;
+        }
+        torque.fill(0.0);
+    }
+}
+
+/// A half kick of free grains `v` (and with `ROT` their spins `omega`) from their forces
+/// and torques.
+fn kick_part<const ROT: bool>(v: &mut [Vec2], f: &mut [Vec2], (dtfm, dtfm2): (&[f64], &[Vec2]), omega: &mut [f64], torque: &mut [f64], dtfi: &[f64]) {
+    #[cfg(all(target_arch = "x86_64", target_feature = "avx512f", target_feature = "avx512vl", target_feature = "avx512bw"))]
+    let from = crate::avx512::kick::<ROT>(crate::avx512::GrainPart { v: &mut *v, f: &mut *f, dtfm, omega: &mut *omega, torque: &mut *torque, dtfi });
+    #[cfg(not(all(target_arch = "x86_64", target_feature = "avx512f", target_feature = "avx512vl", target_feature = "avx512bw")))]
+    let from = {
+        let _ = dtfm;
+        0
+    };
+    // Component by component ([`KickFactors::dtfm2`]).
+    for ((v, f), m) in flat_mut(&mut v[from..]).iter_mut().zip(flat(&f[from..])).zip(flat(&dtfm2[from..])) {
+        *v += *m * *f;
+    }
+    if ROT {
+        for ((w, t), m) in omega[from..].iter_mut().zip(&torque[from..]).zip(&dtfi[from..]) {
+            *w += *m * *t;
+        }
+    }
+}
+
+/// The half kick of all free grains for time step `dt`, on the run's threads.
+fn kick_free<L: ContactLaw, const ROT: bool>(w: &mut World<L>, dt: f64) {
+    let p = &mut w.p;
+    let n = p.n_free;
+    let k = &mut w.kick;
+    k.update(p, dt);
+    let rotation = (&mut p.omega[..n], &mut p.torque[..n], &k.dtfi[..]);
+    w.threads.split(n, ((&mut p.v[..n], &mut p.f[..n], (&k.dtfm[..], &k.dtfm2[..])), rotation), |((v, f, dtfm), (omega, torque, dtfi))| kick_part::<ROT>(v, f, dtfm, omega, torque, dtfi));
+}
+
+/// The components of vectors `v`, as they are stored: x, y, x, y, ...
+fn flat(v: &[Vec2]) -> &[f64] {
+    bytemuck::cast_slice(v)
+}
+
+/// The components of vectors `v`, as they are stored: x, y, x, y, ...
+fn flat_mut(v: &mut [Vec2]) -> &mut [f64] {
+    bytemuck::cast_slice_mut(v)
+}
+
+/// Second half kick of the free grains, or left to the next drift when nothing looks at
+/// the grains before it ([`KickFactors::defer`]).
 #[derive(Default)]
 pub struct FinalIntegrate<const ROT: bool>;
 
@@ -151,25 +264,11 @@ impl<L: ContactLaw, const ROT: bool> Stage<L> for FinalIntegrate<ROT> {
         "FinalKick".into()
     }
     fn run(&mut self, w: &mut World<L>) -> Result<(), Error> {
-        let p = &mut w.p;
-        let n = p.n_free;
-        let k = &mut w.kick;
-        k.update(p, w.dt);
-        let rotation = (&mut p.omega[..n], &mut p.torque[..n], &k.dtfi[..]);
-        w.threads.split(n, ((&mut p.v[..n], &mut p.f[..n], &k.dtfm[..]), rotation), |((v, f, dtfm), (omega, torque, dtfi))| {
-            #[cfg(all(target_arch = "x86_64", target_feature = "avx512f", target_feature = "avx512vl", target_feature = "avx512bw"))]
-            let from = crate::avx512::kick::<ROT>(crate::avx512::GrainPart { v: &mut *v, f: &mut *f, dtfm, omega: &mut *omega, torque: &mut *torque, dtfi });
-            #[cfg(not(all(target_arch = "x86_64", target_feature = "avx512f", target_feature = "avx512vl", target_feature = "avx512bw")))]
-            let from = 0;
-            for ((v, f), m) in v[from..].iter_mut().zip(&f[from..]).zip(&dtfm[from..]) {
-                *v += *m * *f;
-            }
-            if ROT {
-                for ((w, t), m) in omega[from..].iter_mut().zip(&torque[from..]).zip(&dtfi[from..]) {
-                    *w += *m * *t;
-                }
-            }
-        });
+        if w.kick.defer {
+            w.kick.pending = Some(PendingKick { dt: w.dt, spin: ROT });
+        } else {
+            kick_free::<L, ROT>(w, w.dt);
+        }
         Ok(())
     }
 }

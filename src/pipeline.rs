@@ -722,6 +722,8 @@ impl<L: ContactLaw> Stage<L> for Watchdog {
             return Err(w.unstable(what));
         }
         if w.step % self.every == 0 {
+            // The velocities as they are at the end of the step.
+            crate::integrate::settle(w);
             w.check_finite()?;
         }
         Ok(())

@@ -178,7 +178,10 @@ pub fn run_built(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<S
     let t0 = Instant::now();
     let mut error: Option<Error> = None;
     for k in 1..=total {
-        if let Err(err) = e.step() {
+        // Whether anything below looks at the grains after this step: else the step's
+        // final half kick is left to the next one's drift.
+        let look = impact.is_some() || k % sample_every == 0 || k == total || frame_every.is_some_and(|every| k % every == 0);
+        if let Err(err) = e.advance(look) {
             error = Some(err);
             break;
         }

@@ -150,11 +150,24 @@ impl<L: ContactLaw> Simulation<L> {
     /// Advance one step.
     #[inline]
     pub fn step(&mut self) -> Result<(), Error> {
+        self.advance(true)
+    }
+
+    /// Advance one step; with `look` false nothing will look at the grains' velocities
+    /// (or spins) before the next step, so the final half kick may be left to the next
+    /// drift (the same bits: [`crate::integrate`]). After an error the state is whole.
+    #[inline]
+    pub fn advance(&mut self, look: bool) -> Result<(), Error> {
         self.world.step += 1;
+        self.world.kick.defer = !look;
         for (s, t) in self.stages.iter_mut().zip(self.timers.iter_mut()) {
             let t0 = Instant::now();
-            s.run(&mut self.world)?;
+            let done = s.run(&mut self.world);
             *t += t0.elapsed();
+            if done.is_err() {
+                crate::integrate::settle(&mut self.world);
+            }
+            done?;
         }
         Ok(())
     }
