@@ -61,7 +61,7 @@ impl<L: ContactLaw> Stage<L> for UpdateNeighbours {
     fn run(&mut self, w: &mut World<L>) -> Result<(), Error> {
         if w.neighbours.needs_rebuild(w.p.len()) {
             let pairs = w.neighbours.build(&w.p.x, &w.p.r, w.p.n_free, &w.boundary, &w.threads);
-            w.pairs.replace(pairs, &w.p.r, &w.p.m);
+            w.pairs.replace(pairs, &w.p.r, &w.p.m, &w.threads);
         }
         Ok(())
     }
@@ -749,7 +749,7 @@ mod tests {
             let x: Vec<Vec2> = (0..n).map(|_| Vec2::new(rng.random::<f64>() - 0.5, 0.3 * rng.random::<f64>())).collect();
             let r: Vec<f64> = (0..n).map(|_| 0.01 + 0.01 * rng.random::<f64>()).collect();
             let mut list: PairList<f64> = PairList::default();
-            list.replace(brute_force_pairs(&x, &r, n, &boundary, 0.01), &r, &vec![1.0; n]);
+            list.replace(brute_force_pairs(&x, &r, n, &boundary, 0.01), &r, &vec![1.0; n], &crate::threads::Threads::serial());
             let np = list.pairs.len();
             let seam = list.pairs.iter().filter(|p| (x[p[0] as usize].x - x[p[1] as usize].x).abs() > 0.5).count();
             assert!(np > 200 && (seam > 5) == boundary.is_periodic(), "{np} pairs, {seam} across the seam");
@@ -779,7 +779,7 @@ mod tests {
         let x: Vec<Vec2> = (0..n).map(|_| Vec2::new(rng.random::<f64>(), 0.3 * rng.random::<f64>())).collect();
         let r: Vec<f64> = (0..n).map(|_| 0.01 + 0.01 * rng.random::<f64>()).collect();
         let mut list: PairList<f64> = PairList::default();
-        list.replace(brute_force_pairs(&x, &r, n, &boundary, 0.01), &r, &vec![1.0; n]);
+        list.replace(brute_force_pairs(&x, &r, n, &boundary, 0.01), &r, &vec![1.0; n], &crate::threads::Threads::serial());
         let np = list.pairs.len();
         assert!(np > 100, "{np} pairs");
         let active: Vec<bool> = (0..np).map(|_| rng.random::<bool>()).collect();

@@ -106,3 +106,79 @@ fn the_hand_over_probe_times_every_sample_and_checks_its_input() {
         assert!(e.contains(field), "{e}");
     }
 }
+
+/// A neighbour-list rebuild on two threads carries every kept pair's history, touching
+/// flag and energy memory over as one thread does, and computes the same constants: a
+/// random old list, a new list sharing about half its pairs, each thread's stretch
+/// finding its place in the old list by bisection.
+#[test]
+fn two_threads_rebuild_the_pair_list_as_one() {
+    use grainlab::neighbor::PairList;
+    use grainlab::threads::Threads;
+    use rand::{Rng, SeedableRng};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+    let n = 3000;
+    let r: Vec<f64> = (0..n).map(|_| 0.001 + 0.001 * rng.random::<f64>()).collect();
+    let m: Vec<f64> = r.iter().map(|r| 2500.0 * std::f64::consts::PI * r * r).collect();
+    let list = |rng: &mut rand_chacha::ChaCha8Rng| {
+        let mut v: Vec<[u32; 2]> = (0..12_000).map(|_| {
+            let i = rng.random_range(0..n as u32 - 1);
+            [i, rng.random_range(i + 1..n as u32)]
+        }).collect();
+        v.sort_unstable();
+        v.dedup();
+        v
+    };
+    let old = list(&mut rng);
+    let mut new: Vec<[u32; 2]> = old.iter().copied().filter(|_| rng.random::<bool>()).collect();
+    new.extend(list(&mut rng));
+    new.sort_unstable();
+    new.dedup();
+    // The second thread's stretch starts at the middle: make that a kept pair, whose
+    // history its bisection must find.
+    while old.binary_search(&new[new.len() / 2]).is_err() {
+        new.remove(new.len() / 2);
+    }
+    for keep_energy in [false, true] {
+        let rebuilt = |threads: &Threads| {
+            let mut l: PairList<f64> = PairList::default();
+            l.keep_energy = keep_energy;
+            l.replace(old.clone(), &r, &m, &Threads::serial());
+            for k in 0..old.len() {
+                l.hist[k] = k as f64 + 0.5;
+                l.active[k] = k % 3 == 0;
+                if keep_energy {
+                    l.energy[k].ut_prev = 2.0 * k as f64;
+                }
+            }
+            // Twice: the second time into the arrays the first left spare, which hold
+            // the states of the list before (every entry must be written again).
+            l.replace(new.clone(), &r, &m, threads);
+            l.hist.iter_mut().for_each(|h| *h += 1000.0);
+            l.active.iter_mut().for_each(|a| *a = !*a);
+            l.replace(old.clone(), &r, &m, threads);
+            l.hist.iter_mut().for_each(|h| *h -= 1000.0);
+            l.active.iter_mut().for_each(|a| *a = !*a);
+            l.replace(new.clone(), &r, &m, threads);
+            l
+        };
+        let (a, b) = (rebuilt(&Threads::serial()), rebuilt(&Threads::new(2).unwrap()));
+        let kept = a.hist.iter().filter(|&&h| h != 0.0).count();
+        assert!(kept > 3000 && new.len() > 15_000, "{kept} of {} pairs kept", new.len());
+        assert_eq!(&a.pairs[..], &b.pairs[..]);
+        assert_eq!(a.hist.iter().map(|h| h.to_bits()).collect::<Vec<_>>(), b.hist.iter().map(|h| h.to_bits()).collect::<Vec<_>>());
+        assert_eq!(a.active, b.active);
+        assert_eq!(a.energy.iter().map(|e| e.ut_prev.to_bits()).collect::<Vec<_>>(), b.energy.iter().map(|e| e.ut_prev.to_bits()).collect::<Vec<_>>());
+        for (ca, cb) in a.consts.iter().zip(&b.consts) {
+            assert_eq!([ca.r_star, ca.sqrt_m_star, ca.inv_r_min].map(f64::to_bits), [cb.r_star, cb.sqrt_m_star, cb.inv_r_min].map(f64::to_bits));
+        }
+        assert_eq!(a.reach.iter().map(|x| x.to_bits()).collect::<Vec<_>>(), b.reach.iter().map(|x| x.to_bits()).collect::<Vec<_>>());
+        // Against the definition: a pair kept has its old state, a new one none.
+        for (k, p) in new.iter().enumerate() {
+            match old.binary_search(p) {
+                Ok(o) => assert_eq!((a.hist[k], a.active[k]), (o as f64 + 0.5, o % 3 == 0)),
+                Err(_) => assert_eq!((a.hist[k], a.active[k]), (0.0, false)),
+            }
+        }
+    }
+}
