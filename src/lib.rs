@@ -22,8 +22,9 @@
 //!    contact history survives rebuilds ([`neighbor`]); x may be periodic ([`boundary`]);
 //!    walls are flat or rough, fixed or loaded ([`walls`]).
 //! 4. **Simulation** ([`sim`]): velocity Verlet ([`integrate`]; on AVX-512 CPUs eight
-//!    grains at a time, module `avx512`) runs the stages each step, timed per stage; a
-//!    watchdog stops a run that goes unstable, with a diagnosis.
+//!    grains at a time, module `avx512`; between the steps a run looks at, a step's final
+//!    half kick rides along the next drift, with the same bits) runs the stages each
+//!    step, timed per stage; a watchdog stops a run that goes unstable, with a diagnosis.
 //!    With the `parallel` feature the per-grain stages and the contact forces run on
 //!    several threads ([`threads`], [`parallel`]), bit for bit the same as on one.
 //! 5. **Observers** ([`observe`]): the energy balance, impact measurements, wall stresses,
