@@ -129,15 +129,7 @@ impl Threads {
     pub fn split<P: Split>(&self, n: usize, part: P, f: impl Fn(P) + Sync) {
         #[cfg(feature = "parallel")]
         if self.pool.is_some() && n >= MIN_PER_THREAD * self.count() {
-            let bounds = self.bounds(n);
-            let mut parts = Vec::with_capacity(bounds.len() - 1);
-            let mut rest = part;
-            for w in bounds.windows(2) {
-                let (a, b) = rest.split_at(w[1] - w[0]);
-                parts.push(a);
-                rest = b;
-            }
-            self.each(parts, |_, p| f(p));
+            self.split_at_bounds(&self.bounds(n), part, |_, p| f(p));
             return;
         }
         let _ = n;
@@ -159,23 +151,31 @@ impl Threads {
             let mut bounds = self.bounds(n);
             let t = self.count();
             bounds[..t].iter_mut().for_each(|b| *b = (*b).min(n_free));
-            let mut parts = Vec::with_capacity(bounds.len() - 1);
-            let mut rest = Some(part);
-            for w in bounds.windows(2) {
-                let r = rest.take().expect("a part per window");
-                if w[1] == n {
-                    parts.push((w[0]..w[1], r));
-                } else {
-                    let (a, b) = r.split_at(w[1] - w[0]);
-                    parts.push((w[0]..w[1], a));
-                    rest = Some(b);
-                }
-            }
-            self.each(parts, |_, (range, p)| f(range, p));
+            self.split_at_bounds(&bounds, part, f);
             return;
         }
         let _ = n_free;
         f(0..n, part)
+    }
+
+    /// `f(range, part)` on thread r for the part of the grains `range` = `bounds[r]..
+    /// bounds[r + 1]` (one part per thread); the last part has what is left of the arrays.
+    #[cfg(feature = "parallel")]
+    fn split_at_bounds<P: Split>(&self, bounds: &[usize], part: P, f: impl Fn(std::ops::Range<usize>, P) + Sync) {
+        let last = bounds.len() - 2;
+        let mut parts = Vec::with_capacity(last + 1);
+        let mut rest = Some(part);
+        for (r, w) in bounds.windows(2).enumerate() {
+            let p = rest.take().expect("a part per window");
+            if r == last {
+                parts.push((w[0]..w[1], p));
+            } else {
+                let (a, b) = p.split_at(w[1] - w[0]);
+                parts.push((w[0]..w[1], a));
+                rest = Some(b);
+            }
+        }
+        self.each(parts, |_, (range, p)| f(range, p));
     }
 
     /// The bounds of the threads' parts of `0..n`: `count() + 1` entries.
