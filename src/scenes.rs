@@ -127,6 +127,19 @@ pub fn shear() -> Scene {
     }
 }
 
+/// The seed's shear cell with `count` grains over a periodic length `length`, m: the
+/// same height when `count` grows with `length` (1000 grains per 0.04 m), as the tests
+/// and `scripts/bench-peers` size it.
+pub fn shear_cell(count: usize, length: f64) -> Scene {
+    let mut s = shear();
+    if let Grains::Pack(p) = &mut s.grains {
+        p.count = count;
+        p.x = [0.0, length];
+    }
+    s.domain.periodic_x = Some([0.0, length]);
+    s
+}
+
 /// A built-in scene by name.
 pub fn builtin(name: &str) -> Option<Scene> {
     match name {

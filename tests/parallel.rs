@@ -2,21 +2,16 @@
 #![cfg(feature = "parallel")]
 
 use grainlab::build_with;
-use grainlab::scene::{Grains, TangentialSpec};
-use grainlab::scenes::shear;
+use grainlab::scene::TangentialSpec;
+use grainlab::scenes::shear_cell;
 
 #[test]
 fn two_threads_give_the_same_bits_as_one() {
     // The contact forces are gathered per grain in pair order and the energy terms in
     // pair order, so floating-point sums happen in the serial order: not "close", equal.
     for tangential in [TangentialSpec::TotalDisplacement, TangentialSpec::IncrementalForce] {
-        let mut s = shear();
+        let mut s = shear_cell(3000, 0.12);
         s.model.tangential = tangential;
-        if let Grains::Pack(p) = &mut s.grains {
-            p.count = 3000;
-            p.x = [0.0, 0.12];
-        }
-        s.domain.periodic_x = Some([0.0, 0.12]);
         let mut a = build_with(&s, 1).unwrap();
         let mut b = build_with(&s, 2).unwrap();
         assert!(b.explain().contains("parallel, 2 threads"), "{}", b.explain());

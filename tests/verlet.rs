@@ -4,19 +4,11 @@
 
 use grainlab::build_with;
 use grainlab::neighbor::brute_force_pairs;
-use grainlab::scene::Grains;
-use grainlab::scenes::shear;
+use grainlab::scenes::shear_cell;
 
 #[test]
 fn every_touching_pair_is_in_the_list_at_every_step() {
-    let mut s = shear();
-    let width = 0.016;
-    if let Grains::Pack(p) = &mut s.grains {
-        p.count = 400;
-        p.x = [0.0, width];
-    }
-    s.domain.periodic_x = Some([0.0, width]);
-    let mut sim = build_with(&s, 1).unwrap();
+    let mut sim = build_with(&shear_cell(400, 0.016), 1).unwrap();
     let mut checked = 0;
     for step in 0..4000 {
         sim.engine.step().unwrap();
@@ -41,13 +33,8 @@ fn every_touching_pair_is_in_the_list_at_every_step() {
 #[test]
 fn a_final_kick_left_to_the_next_drift_gives_the_same_bits() {
     for rotation in [true, false] {
-        let mut s = shear();
+        let mut s = shear_cell(300, 0.012);
         s.model.rotation = rotation;
-        if let Grains::Pack(p) = &mut s.grains {
-            p.count = 300;
-            p.x = [0.0, 0.012];
-        }
-        s.domain.periodic_x = Some([0.0, 0.012]);
         let (mut a, mut b) = (build_with(&s, 1).unwrap(), build_with(&s, 1).unwrap());
         let mut behind = 0;
         for k in 1..=1500 {
