@@ -28,59 +28,19 @@ use std::ops::Range;
 
 use crate::boundary::{Boundary, ROUND_EXACT_FROM, ROUND_SHIFT};
 use crate::dim::Vec2;
-use crate::neighbor::CheckedPairs;
 
-/// Pairs per step of [`sweep_eights`].
+/// Pairs per step of [`eights`].
 pub const WIDTH: usize = 8;
 
-/// Sort out the pairs `range.start..range.start + 8 m` (the largest multiple of eight
-/// that fits in `range`) as the portable sweep does, leaving out those in `skip`
-/// (ascending, within the range): touching pairs appended to `touching` (with their
-/// separations to `sep`) from `nt` on, released ones to `released` from `nr` on; `nt`
-/// and `nr` move on. Every pair before the range is sorted out or skipped already, so
-/// `nt` and `nr` are at most `range.start`. Returns the end of what it swept, for the
-/// portable sweep to take the rest. Skipped pairs (the parallel stage's cross pairs) are
-/// masked lanes, not breaks in the sweep: the eight-wide blocks go on undisturbed.
-#[allow(clippy::too_many_arguments)]
-pub fn sweep_eights(
-    x: &[Vec2],
-    boundary: &Boundary,
-    pairs: CheckedPairs<'_>,
-    reach: &[f64],
-    active: &[bool],
-    skip: &[u32],
-    range: Range<usize>,
-    touching: &mut [u32],
-    sep: &mut [Vec2],
-    released: &mut [u32],
-    nt: &mut usize,
-    nr: &mut usize,
-) -> usize {
-    let end = range.start + range.len() / WIDTH * WIDTH;
-    let (mut t, mut r) = (*nt, *nr);
-    // Every read below is of pairs before `end`, and of the grains of those pairs
-    // (`CheckedPairs::of` checks that `x` covers them). Every write is of at most eight
-    // entries from `t` or `r`, which are at most the index of the first pair of the
-    // eight: so within `end`.
-    let xs = pairs.of(x);
-    assert!(end <= pairs.len() && end <= reach.len() && end <= active.len());
-    // The gathers take a grain index doubled as an i32 offset.
-    assert!(x.len() <= 1 << 30, "{} grains: the AVX-512 sweep takes at most 2^30", x.len());
-    assert!(t <= range.start && r <= range.start && end <= touching.len().min(sep.len()).min(released.len()));
-    assert!(skip.first().is_none_or(|&k| k as usize >= range.start) && skip.is_sorted());
-    let list = pairs.pairs().as_ptr();
-    // SAFETY: the build targets these features (the module is compiled only then), and
-    // the pointers are good for the pairs before `end` (asserted above).
-    unsafe { eights(list, xs.as_ptr() as *const f64, boundary, reach.as_ptr(), active.as_ptr(), skip, range.start..end, touching.as_mut_ptr(), sep.as_mut_ptr(), released.as_mut_ptr(), &mut t, &mut r) };
-    (*nt, *nr) = (t, r);
-    end
-}
-
-/// The loop of [`sweep_eights`] over `range` (a multiple of eight pairs), on raw
-/// pointers that are good for it.
+/// The sweep's loop over `range` (a multiple of eight pairs): `sweep_wide` in
+/// src/pipeline.rs calls it.
+///
+/// # Safety
+/// The pointers must be good for the pairs of `range`, their grains and the writes, as
+/// `WideLoop` (src/pipeline.rs) says; `sweep_wide` asserts it.
 #[target_feature(enable = "avx512f,avx512vl,avx512bw")]
 #[allow(clippy::too_many_arguments)]
-unsafe fn eights(list: *const [u32; 2], xp: *const f64, boundary: &Boundary, reach: *const f64, active: *const bool, skip: &[u32], range: Range<usize>, touching: *mut u32, sep: *mut Vec2, released: *mut u32, t: &mut usize, r: &mut usize) {
+pub unsafe fn eights(list: *const [u32; 2], xp: *const f64, boundary: &Boundary, reach: *const f64, active: *const bool, skip: &[u32], range: Range<usize>, touching: *mut u32, sep: *mut Vec2, released: *mut u32, t: &mut usize, r: &mut usize) {
     let period = _mm512_set1_pd(boundary.period);
     let inv_period = _mm512_set1_pd(boundary.inv_period());
     let (shift, exact) = (_mm512_set1_pd(ROUND_SHIFT), _mm512_set1_pd(ROUND_EXACT_FROM));
@@ -95,8 +55,8 @@ unsafe fn eights(list: *const [u32; 2], xp: *const f64, boundary: &Boundary, rea
         while let Some(m) = skip.next_if(|&m| m < k + WIDTH) {
             left_out |= 1 << (m - k);
         }
-        // SAFETY: see the caller; a grain index doubled is a positive i32 offset
-        // (asserted there: fewer than 2^30 grains).
+        // SAFETY: the caller's (`sweep_wide`'s checks); a grain index doubled is a
+        // positive i32 offset (asserted there: at most 2^30 grains).
         unsafe {
             // Eight pairs as eight u64 (j << 32 | i): i and j as eight u32 each.
             let p = _mm512_loadu_si512(list.add(k) as *const __m512i);

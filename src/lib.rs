@@ -17,8 +17,8 @@
 //!    increments), one monomorphized kernel per named combination. The law is written
 //!    once, generic over its number type, and runs one contact or four in SIMD lanes with
 //!    the same bits ([`lanes`]); a sweep over the Verlet list hands it the touching
-//!    pairs (on AVX-512 CPUs eight pairs at a time, module `avx512`, compiled in only
-//!    for them, with the portable sweep's bits). Neighbours come from a cell list with a skin, and
+//!    pairs (on AVX-512 CPUs eight pairs at a time, module `avx512`; on AVX2 CPUs four,
+//!    module `avx2`: each compiled in only for its CPUs, with the portable sweep's bits). Neighbours come from a cell list with a skin, and
 //!    contact history survives rebuilds ([`neighbor`]); x may be periodic ([`boundary`]);
 //!    walls are flat or rough, fixed or loaded ([`walls`]).
 //! 4. **Simulation** ([`sim`]): velocity Verlet ([`integrate`]; on AVX-512 CPUs eight
@@ -42,6 +42,8 @@
 //! Everything is SI: m, kg, s, N, Pa, J.
 
 pub mod accuracy;
+#[cfg(all(target_arch = "x86_64", target_feature = "avx2", not(all(target_feature = "avx512f", target_feature = "avx512vl", target_feature = "avx512bw"))))]
+pub mod avx2;
 #[cfg(all(target_arch = "x86_64", target_feature = "avx512f", target_feature = "avx512vl", target_feature = "avx512bw"))]
 pub mod avx512;
 pub mod boundary;

@@ -386,15 +386,76 @@ impl Ledgers<'_> {
 /// pair's `(r_i + r_j)^2` ([`crate::neighbor::PairList::reach`]). `skip` (indices into
 /// the part, ascending) leaves out pairs computed elsewhere: the portable sweep sweeps
 /// the stretches between them one after the other, so that no pair pays for a test; the
-/// AVX-512 sweep masks their lanes. No branch per pair, and the lists keep their length
-/// from step to step (no clearing).
+/// CPU-specific sweeps (AVX-512, AVX2) mask their lanes. No branch per pair, and the
+/// lists keep their length from step to step (no clearing).
 #[allow(clippy::too_many_arguments)]
 pub fn sort_pairs(x: &[Vec2], boundary: &Boundary, pairs: CheckedPairs<'_>, reach: &[f64], active: &[bool], skip: &[u32], touching: &mut Vec<u32>, sep: &mut Vec<Vec2>, released: &mut Vec<u32>) -> (usize, usize) {
     sort_pairs_with(true, x, boundary, pairs, reach, active, skip, touching, sep, released)
 }
 
+/// The loop of a CPU-specific sweep of [`sort_pairs`] over `range` (a multiple of its
+/// width), as [`sweep_wide`] describes it, on raw pointers: the list, the grains' (x, y)
+/// values, the boundary, `reach`, the touching flags, the pairs to skip (ascending, within
+/// the range), the three outputs and their counts. The caller makes sure that the
+/// pointers are good for the pairs of the range and their grains, and that every write
+/// (at most a width of entries from a count, which is at most the index of the first
+/// pair of the width) falls within the range.
+type WideLoop = unsafe fn(*const [u32; 2], *const f64, &Boundary, *const f64, *const bool, &[u32], std::ops::Range<usize>, *mut u32, *mut Vec2, *mut u32, &mut usize, &mut usize);
+
+/// The CPU-specific sweep the build has, as its width (pairs per step) and loop: eight
+/// pairs a step with AVX-512 ([`crate::avx512`]), four with AVX2 alone
+/// ([`crate::avx2`]), none otherwise.
+#[cfg(all(target_arch = "x86_64", target_feature = "avx512f", target_feature = "avx512vl", target_feature = "avx512bw"))]
+const WIDE_SWEEP: Option<(usize, WideLoop)> = Some((crate::avx512::WIDTH, crate::avx512::eights));
+#[cfg(all(target_arch = "x86_64", target_feature = "avx2", not(all(target_feature = "avx512f", target_feature = "avx512vl", target_feature = "avx512bw"))))]
+const WIDE_SWEEP: Option<(usize, WideLoop)> = Some((crate::avx2::WIDTH, crate::avx2::fours));
+#[cfg(not(any(all(target_arch = "x86_64", target_feature = "avx512f", target_feature = "avx512vl", target_feature = "avx512bw"), all(target_arch = "x86_64", target_feature = "avx2", not(all(target_feature = "avx512f", target_feature = "avx512vl", target_feature = "avx512bw"))))))]
+const WIDE_SWEEP: Option<(usize, WideLoop)> = None;
+
+/// Sort out the pairs `range.start..range.start + width m` (the largest multiple of
+/// `width` that fits in `range`) with a CPU-specific loop `body`, as the portable sweep
+/// does, leaving out those in `skip` (ascending, within the range): touching pairs
+/// appended to `touching` (with their separations to `sep`) from `nt` on, released ones to
+/// `released` from `nr` on; `nt` and `nr` move on. Every pair before the range is sorted
+/// out or skipped already, so `nt` and `nr` are at most `range.start`. Returns the end of
+/// what it swept, for the portable sweep to take the rest. Skipped pairs (the parallel
+/// stage's cross pairs) are masked lanes, not breaks in the sweep.
+#[allow(clippy::too_many_arguments, dead_code)]
+fn sweep_wide(
+    (width, body): (usize, WideLoop),
+    x: &[Vec2],
+    boundary: &Boundary,
+    pairs: CheckedPairs<'_>,
+    reach: &[f64],
+    active: &[bool],
+    skip: &[u32],
+    range: std::ops::Range<usize>,
+    touching: &mut [u32],
+    sep: &mut [Vec2],
+    released: &mut [u32],
+    nt: &mut usize,
+    nr: &mut usize,
+) -> usize {
+    let end = range.start + range.len() / width * width;
+    // Every read of the loop is of pairs before `end`, and of the grains of those pairs
+    // (`CheckedPairs::of` checks that `x` covers them). Every write is of at most `width`
+    // entries from `nt` or `nr`, which are at most the index of the first pair of the
+    // width: so within `end`.
+    let xs = pairs.of(x);
+    assert!(end <= pairs.len() && end <= reach.len() && end <= active.len());
+    // The AVX-512 loop's gathers take a grain index doubled as an i32 offset.
+    assert!(x.len() <= 1 << 30, "{} grains: the CPU-specific sweeps take at most 2^30", x.len());
+    assert!(*nt <= range.start && *nr <= range.start && end <= touching.len().min(sep.len()).min(released.len()));
+    assert!(skip.first().is_none_or(|&k| k as usize >= range.start) && skip.is_sorted());
+    // SAFETY: the build targets the loop's CPU features (it is compiled only then), and
+    // the pointers are good for the pairs before `end`, their grains and the writes
+    // (asserted above).
+    unsafe { body(pairs.pairs().as_ptr(), xs.as_ptr() as *const f64, boundary, reach.as_ptr(), active.as_ptr(), skip, range.start..end, touching.as_mut_ptr(), sep.as_mut_ptr(), released.as_mut_ptr(), nt, nr) };
+    end
+}
+
 /// [`sort_pairs`], with the CPU-specific sweep (`wide`, where the build has one:
-/// [`crate::avx512`]) or the portable one alone (for the tests that compare them).
+/// [`WIDE_SWEEP`]) or the portable one alone (for the tests that compare them).
 #[allow(clippy::too_many_arguments)]
 fn sort_pairs_with(wide: bool, x: &[Vec2], boundary: &Boundary, pairs: CheckedPairs<'_>, reach: &[f64], active: &[bool], skip: &[u32], touching: &mut Vec<u32>, sep: &mut Vec<Vec2>, released: &mut Vec<u32>) -> (usize, usize) {
     let np = pairs.len();
@@ -406,15 +467,13 @@ fn sort_pairs_with(wide: bool, x: &[Vec2], boundary: &Boundary, pairs: CheckedPa
     let (reach, active, touching, sep, released) = (&reach[..np], &active[..np], &mut touching[..np], &mut sep[..np], &mut released[..np]);
     let (mut nt, mut nr, mut from) = (0, 0, 0);
     // Where the build has a CPU-specific sweep, it takes all but a short tail.
-    #[cfg(all(target_arch = "x86_64", target_feature = "avx512f", target_feature = "avx512vl", target_feature = "avx512bw"))]
-    let skip = if wide {
-        from = crate::avx512::sweep_eights(x, boundary, pairs, reach, active, skip, 0..np, touching, sep, released, &mut nt, &mut nr);
-        &skip[skip.partition_point(|&k| (k as usize) < from)..]
-    } else {
-        skip
+    let skip = match WIDE_SWEEP {
+        Some(w) if wide => {
+            from = sweep_wide(w, x, boundary, pairs, reach, active, skip, 0..np, touching, sep, released, &mut nt, &mut nr);
+            &skip[skip.partition_point(|&k| (k as usize) < from)..]
+        }
+        _ => skip,
     };
-    #[cfg(not(all(target_arch = "x86_64", target_feature = "avx512f", target_feature = "avx512vl", target_feature = "avx512bw")))]
-    let _ = wide;
     for to in skip.iter().map(|&k| k as usize).chain(std::iter::once(np)) {
         if to > from {
             sweep(x, boundary, pairs, reach, active, from..to, touching, sep, released, &mut nt, &mut nr);
@@ -736,13 +795,13 @@ mod tests {
     use crate::neighbor::{PairList, brute_force_pairs};
     use rand::{Rng, SeedableRng};
 
-    /// The AVX-512 sweep gives the portable sweep's lists and separations, bit for bit:
-    /// across the periodic seam and without periodicity, with pairs released, and with
-    /// skipped pairs at every lane position (masked in the eight-wide blocks, between
-    /// stretches in the portable sweep that takes the tail).
-    #[cfg(all(target_arch = "x86_64", target_feature = "avx512f", target_feature = "avx512vl", target_feature = "avx512bw"))]
+    /// The CPU-specific sweep (AVX-512 or AVX2) gives the portable sweep's lists and
+    /// separations, bit for bit: across the periodic seam and without periodicity, with
+    /// pairs released, and with skipped pairs at every lane position (masked in the wide
+    /// blocks, between stretches in the portable sweep that takes the tail).
+    #[cfg(any(all(target_arch = "x86_64", target_feature = "avx512f", target_feature = "avx512vl", target_feature = "avx512bw"), all(target_arch = "x86_64", target_feature = "avx2", not(all(target_feature = "avx512f", target_feature = "avx512vl", target_feature = "avx512bw")))))]
     #[test]
-    fn avx512_sweep_gives_the_portable_bits() {
+    fn wide_sweep_gives_the_portable_bits() {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
         let n = 400;
         for boundary in [Boundary::periodic_x(-0.5, 1.0), Boundary::open()] {
