@@ -18,9 +18,10 @@
 //!    once, generic over its number type, and runs one contact or four in SIMD lanes with
 //!    the same bits ([`lanes`]); a sweep over the Verlet list hands it the touching
 //!    pairs (on AVX-512 CPUs eight pairs at a time, module `avx512`; on AVX2 CPUs four,
-//!    module `avx2`: each compiled in only for its CPUs, with the portable sweep's bits). Neighbours come from a cell list with a skin, and
-//!    contact history survives rebuilds ([`neighbor`]); x may be periodic ([`boundary`]);
-//!    walls are flat or rough, fixed or loaded ([`walls`]).
+//!    module `avx2`: each compiled in only for its CPUs, with the portable sweep's
+//!    bits). Neighbours come from a cell list with a skin, and contact history survives
+//!    rebuilds ([`neighbor`]); x may be periodic ([`boundary`]); walls are flat or rough,
+//!    fixed or loaded ([`walls`]).
 //! 4. **Simulation** ([`sim`]): velocity Verlet ([`integrate`]; on AVX-512 CPUs eight
 //!    grains at a time, module `avx512`; between the steps a run looks at, a step's final
 //!    half kick rides along the next drift, with the same bits) runs the stages each
