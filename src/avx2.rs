@@ -32,6 +32,7 @@ use std::ops::Range;
 
 use crate::boundary::{Boundary, ROUND_EXACT_FROM, ROUND_SHIFT};
 use crate::dim::Vec2;
+use crate::pipeline::LeftOut;
 
 /// Pairs per step of [`fours`].
 pub const WIDTH: usize = 4;
@@ -75,15 +76,9 @@ pub unsafe fn fours(list: *const [u32; 2], xp: *const f64, boundary: &Boundary, 
     let (shift, exact) = (_mm256_set1_pd(ROUND_SHIFT), _mm256_set1_pd(ROUND_EXACT_FROM));
     let abs = _mm256_castsi256_pd(_mm256_set1_epi64x(i64::MAX));
     let mut k = range.start;
-    let mut skip = skip.iter().map(|&k| k as usize);
-    let mut next_skip = skip.next().unwrap_or(usize::MAX);
+    let mut skip = LeftOut::new(skip);
     while k < range.end {
-        // The lanes to leave out: usually none (one compare).
-        let mut left_out = 0u32;
-        while next_skip < k + WIDTH {
-            left_out |= 1 << (next_skip - k);
-            next_skip = skip.next().unwrap_or(usize::MAX);
-        }
+        let left_out = skip.lanes(k, WIDTH);
         // SAFETY: the caller's (`sweep_wide`'s checks).
         unsafe {
             let p = list.add(k);

@@ -28,6 +28,7 @@ use std::ops::Range;
 
 use crate::boundary::{Boundary, ROUND_EXACT_FROM, ROUND_SHIFT};
 use crate::dim::Vec2;
+use crate::pipeline::LeftOut;
 
 /// Pairs per step of [`eights`].
 pub const WIDTH: usize = 8;
@@ -48,13 +49,9 @@ pub unsafe fn eights(list: *const [u32; 2], xp: *const f64, boundary: &Boundary,
     // Separations from eight x and eight y values back to eight (x, y) pairs.
     let (first, second) = (_mm512_setr_epi64(0, 8, 1, 9, 2, 10, 3, 11), _mm512_setr_epi64(4, 12, 5, 13, 6, 14, 7, 15));
     let mut k = range.start;
-    let mut skip = skip.iter().map(|&k| k as usize).peekable();
+    let mut skip = LeftOut::new(skip);
     while k < range.end {
-        // The lanes to leave out: usually none (one compare).
-        let mut left_out = 0u8;
-        while let Some(m) = skip.next_if(|&m| m < k + WIDTH) {
-            left_out |= 1 << (m - k);
-        }
+        let left_out = skip.lanes(k, WIDTH) as u8;
         // SAFETY: the caller's (`sweep_wide`'s checks); a grain index doubled is a
         // positive i32 offset (asserted there: at most 2^30 grains).
         unsafe {

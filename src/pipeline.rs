@@ -402,6 +402,36 @@ pub fn sort_pairs(x: &[Vec2], boundary: &Boundary, pairs: CheckedPairs<'_>, reac
 /// pair of the width) falls within the range.
 type WideLoop = unsafe fn(*const [u32; 2], *const f64, &Boundary, *const f64, *const bool, &[u32], std::ops::Range<usize>, *mut u32, *mut Vec2, *mut u32, &mut usize, &mut usize);
 
+/// The pairs a CPU-specific sweep leaves out (the `skip` of [`sort_pairs`], ascending),
+/// as lane masks of its blocks of pairs, block after block. (Builds without one do not
+/// use it.)
+#[allow(dead_code)]
+pub(crate) struct LeftOut<'a> {
+    rest: std::slice::Iter<'a, u32>,
+    /// The next pair to leave out (`usize::MAX` when none is left).
+    next: usize,
+}
+
+#[allow(dead_code)]
+impl<'a> LeftOut<'a> {
+    pub(crate) fn new(skip: &'a [u32]) -> Self {
+        let mut rest = skip.iter();
+        let next = rest.next().map_or(usize::MAX, |&k| k as usize);
+        LeftOut { rest, next }
+    }
+    /// The lanes of the block of `width` pairs from `k` to leave out (bit l: pair k + l):
+    /// usually none, at the cost of one compare. Blocks are asked for in ascending order.
+    #[inline(always)]
+    pub(crate) fn lanes(&mut self, k: usize, width: usize) -> u32 {
+        let mut left_out = 0;
+        while self.next < k + width {
+            left_out |= 1 << (self.next - k);
+            self.next = self.rest.next().map_or(usize::MAX, |&k| k as usize);
+        }
+        left_out
+    }
+}
+
 /// The CPU-specific sweep the build has, as its width (pairs per step) and loop: eight
 /// pairs a step with AVX-512 ([`crate::avx512`]), four with AVX2 alone
 /// ([`crate::avx2`]), none otherwise.
