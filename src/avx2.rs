@@ -32,7 +32,7 @@ use std::ops::Range;
 
 use crate::boundary::{Boundary, ROUND_EXACT_FROM, ROUND_SHIFT};
 use crate::dim::Vec2;
-use crate::pipeline::LeftOut;
+use crate::pipeline::{LeftOut, four_flags};
 
 /// Pairs per step of [`fours`].
 pub const WIDTH: usize = 4;
@@ -108,8 +108,7 @@ pub unsafe fn fours(list: *const [u32; 2], xp: *const f64, boundary: &Boundary, 
             _mm256_storeu_pd(out.add(2 * (touch & 3).count_ones() as usize), front(b, touch >> 2));
             *t += touch.count_ones() as usize;
             // Released: touching before (flag bytes 0 or 1), not now. A few per step.
-            let flags = u32::from_le_bytes(std::ptr::read_unaligned(active.add(k) as *const [u8; 4]));
-            let was = flags.wrapping_mul(0x0102_0408) >> 24 & 0xf;
+            let was = four_flags(std::ptr::read_unaligned(active.add(k) as *const [u8; 4]));
             let gone = !(touch | left_out) & was;
             if gone != 0 {
                 for l in 0..WIDTH {

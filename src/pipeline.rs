@@ -402,6 +402,13 @@ pub fn sort_pairs(x: &[Vec2], boundary: &Boundary, pairs: CheckedPairs<'_>, reac
 /// pair of the width) falls within the range.
 type WideLoop = unsafe fn(*const [u32; 2], *const f64, &Boundary, *const f64, *const bool, &[u32], std::ops::Range<usize>, *mut u32, *mut Vec2, *mut u32, &mut usize, &mut usize);
 
+/// Four touching flags (bytes 0 or 1) as the low four bits (bit l: flag l): one load and
+/// one multiply, the shifted copies of the bytes landing on bits 24..27 without carries.
+#[inline(always)]
+pub(crate) fn four_flags(flags: [u8; 4]) -> u32 {
+    u32::from_le_bytes(flags).wrapping_mul(0x0102_0408) >> 24 & 0xf
+}
+
 /// The pairs a CPU-specific sweep leaves out (the `skip` of [`sort_pairs`], ascending),
 /// as lane masks of its blocks of pairs, block after block. (Builds without one do not
 /// use it.)
@@ -534,9 +541,7 @@ fn sweep(x: &[Vec2], boundary: &Boundary, pairs: CheckedPairs<'_>, reach: &[f64]
         let g = xs.four(k);
         let d: Vector2<Lanes> = boundary.image(gather2(|l| g[l].0 - g[l].1));
         let touch = d.norm_squared().simd_lt(gather(|l| rq[l])).bitmask();
-        // The four flags (bytes 0 or 1) as the low four bits: one load, one multiply
-        // (the shifted copies of the bytes land on bits 24..27 without carries).
-        let was = (u32::from_le_bytes([aq[0] as u8, aq[1] as u8, aq[2] as u8, aq[3] as u8]).wrapping_mul(0x0102_0408) >> 24 & 0xf) as u64;
+        let was = four_flags([aq[0] as u8, aq[1] as u8, aq[2] as u8, aq[3] as u8]) as u64;
         // Touching: every index written, the count moved on where it touches.
         for l in 0..LANES {
             debug_assert!(t <= k + l);
