@@ -95,7 +95,7 @@ pub fn beta(restitution: f64) -> f64 {
 }
 
 /// The mixed properties of one material pair (`R = Lanes`: of four pairs, one per lane).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PairMaterial<R = f64> {
     /// Effective Young's modulus E*, Pa.
     pub e_star: R,

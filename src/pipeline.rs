@@ -11,7 +11,6 @@ use simba::simd::{SimdBool, SimdPartialOrd, SimdValue};
 use crate::boundary::Boundary;
 use crate::contact::damping::Damping;
 use crate::contact::tangential::Tangential;
-use crate::contact::model::ContactState;
 use crate::contact::{ContactInput, ContactLaw, ContactModel, EnergyMemory, EnergyTerms, LeverArm};
 use crate::dim::{Vec2, cross};
 use crate::lanes::{LANES, Lanes, Real, gather, gather2, lane2};
@@ -228,164 +227,90 @@ pub fn pair_contact<Dm: Damping, T: Tangential, const ENERGY: bool>(
     o
 }
 
-/// What the kernel reads of four touching pairs, gathered into lanes: their separations
-/// (minimum image, i minus j, m), radii (m), spins (rad/s), relative velocity (m/s),
-/// constants and tangential states.
-#[derive(Clone, Copy, Default)]
-struct QuadIn<T: Tangential> {
-    d: Vector2<Lanes>,
-    ri: Lanes,
-    rj: Lanes,
-    wi: Lanes,
-    wj: Lanes,
-    v_rel: Vector2<Lanes>,
-    r_star: Lanes,
-    sqrt_m_star: Lanes,
-    inv_r_min: Lanes,
-    h: T::History<Lanes>,
-}
-
-/// What the kernel gives four touching pairs: the force on the first grains (N), the
-/// torques to subtract from each grain (N m), the overlap over the smaller radius, and
-/// the tangential states moved on.
-#[derive(Clone, Copy, Default)]
-struct QuadOut<T: Tangential> {
-    force: Vector2<Lanes>,
-    torque: [Lanes; 2],
-    ratio: Lanes,
-    h: T::History<Lanes>,
-}
-
-/// Quadruples of touching pairs per block of the kernel ([`touching_quads`]): 8 took
-/// the least time at 5000 grains (A/B in one run, contact stage against the one-loop
-/// kernel: 4 quadruples 0.86-0.88, 6 0.86, 8 0.85, 16 0.86, 32 0.88-0.90).
-const QUADS_PER_BLOCK: usize = 8;
-
-/// Gather four touching pairs into lanes (`ks`: their indices in the list part, `ds`
-/// their separations); with several materials, their pair materials into `pm`.
+/// Four touching pairs at once, one per SIMD lane (`ks`: their indices in the list, `ds`
+/// their separations): the same bits as [`one_pair`] gives each of them, handed to
+/// `sink` (index in the part, grains, output) in lane order; with `ENERGY`, their energy
+/// terms (also in lanes, their energy memories moved on) go to `pending`.
 #[inline(always)]
-fn gather_quad<Dm: Damping, T: Tangential>(w: &PairView<'_, ContactModel<Dm, T>>, list: &PairSlices<'_, T>, ks: &[u32], ds: &[Vec2], pm: Option<&mut PairMaterial<Lanes>>) -> QuadIn<T> {
-    let p = w.p;
+#[allow(clippy::too_many_arguments)]
+fn four_pairs<Dm: Damping, T: Tangential, const ENERGY: bool>(
+    w: &PairView<'_, ContactModel<Dm, T>>,
+    list: PairSlices<'_, T>,
+    single: Option<&PairMaterial<Lanes>>,
+    ks: &[u32],
+    ds: &[Vec2],
+    sink: &mut impl FnMut(usize, (usize, usize), PairOut),
+    pending: &mut [EnergyTerms],
+    best: &mut (f64, usize),
+) {
+    let (model, p) = (w.law, w.p);
+    let lever = model.options.lever_arm;
     // The per-pair slices cut to one length, so that one bounds check per index serves
     // them all; the per-grain arrays are read through the checked list, with none.
     let np = list.pairs.len();
-    let (consts, hist) = (&list.consts[..np], &list.hist[..np]);
+    let (pairs, consts, hist, active) = (list.pairs.pairs(), &list.consts[..np], &mut list.hist[..np], &mut list.active[..np]);
     let (v, r, omega) = (list.pairs.of(&p.v), list.pairs.of(&p.r), list.pairs.of(&p.omega));
     let ks: [usize; LANES] = std::array::from_fn(|l| ks[l] as usize);
+    let ij: [(usize, usize); LANES] = std::array::from_fn(|l| {
+        let q = pairs[ks[l]];
+        (q[0] as usize, q[1] as usize)
+    });
     let pc: [&PairConst; LANES] = std::array::from_fn(|l| &consts[ks[l]]);
+    let d = gather2(|l| ds[l]);
     let rs: [(f64, f64); LANES] = std::array::from_fn(|l| r.at(ks[l]));
+    let (ri, rj) = (gather(|l| rs[l].0), gather(|l| rs[l].1));
     let (wi, wj) = if T::FRICTION {
         let ws: [(f64, f64); LANES] = std::array::from_fn(|l| omega.at(ks[l]));
         (gather(|l| ws[l].0), gather(|l| ws[l].1))
     } else {
         (Lanes::splat(0.0), Lanes::splat(0.0))
     };
-    if let Some(pm) = pm {
-        let mat = list.pairs.of(&p.material);
-        *pm = PairMaterial::gather(std::array::from_fn(|l| {
-            let (mi, mj) = mat.at(ks[l]);
-            w.pair_table.get(mi as usize, mj as usize)
-        }));
-    }
-    QuadIn {
-        d: gather2(|l| ds[l]),
-        ri: gather(|l| rs[l].0),
-        rj: gather(|l| rs[l].1),
-        wi,
-        wj,
-        v_rel: gather2(|l| {
-            let (vi, vj) = v.at(ks[l]);
-            vi - vj
-        }),
-        r_star: gather(|l| pc[l].r_star),
-        sqrt_m_star: gather(|l| pc[l].sqrt_m_star),
-        inv_r_min: gather(|l| pc[l].inv_r_min),
-        h: T::gather(std::array::from_fn(|l| &hist[ks[l]])),
-    }
-}
-
-/// The forces of four touching pairs gathered in lanes, with the same bits as
-/// [`one_pair`] gives each of them; also their contact input and state, for the energy
-/// accounting.
-#[inline(always)]
-fn quad_force<Dm: Damping, T: Tangential>(model: &ContactModel<Dm, T>, dt: f64, q: &QuadIn<T>, pm: &PairMaterial<Lanes>) -> (QuadOut<T>, ContactInput<Lanes>, ContactState<Lanes>) {
-    let lever = model.options.lever_arm;
-    let input = pair_input::<Lanes, T>(lever, q.d, q.ri, q.rj, q.wi, q.wj, q.v_rel, q.r_star, q.sqrt_m_star, Lanes::splat(dt));
-    let mut h = q.h;
-    let c = model.force(&input, pm, &mut h);
-    let torque = if T::FRICTION { pair_torque(lever, &input, c.tangential.elastic + c.tangential.damping, q.ri, q.rj) } else { [Lanes::splat(0.0); 2] };
-    let ratio = input.dn * q.inv_r_min;
-    (QuadOut { force: c.force, torque, ratio, h }, input, c)
-}
-
-/// The touching pairs of a list part, four at a time in SIMD lanes, in blocks of
-/// [`QUADS_PER_BLOCK`] quadruples: the block's inputs are gathered first, then the
-/// kernel runs over them, then their outputs go to `sink` (index in the part, grains,
-/// output) and to the list, in list order. Three short loops instead of one long one:
-/// the kernel's loop holds little besides its arithmetic, and the CPU overlaps the
-/// square roots and divisions of successive quadruples instead of waiting on each. (One
-/// loop doing all three was 667 instructions per quadruple, 210 of them spills to the
-/// stack and reloads; CPU-clock samples piled up behind its square roots.) With
-/// `ENERGY`, the energy terms too (their energy memories moved on) go to `pending`.
-/// `touching.len()` must be a multiple of [`LANES`].
-#[inline(always)]
-#[allow(clippy::too_many_arguments)]
-fn touching_quads<Dm: Damping, T: Tangential, const ENERGY: bool>(
-    w: &PairView<'_, ContactModel<Dm, T>>,
-    list: PairSlices<'_, T>,
-    touching: &[u32],
-    sep: &[Vec2],
-    sink: &mut impl FnMut(usize, (usize, usize), PairOut),
-    pending: &mut [EnergyTerms],
-    best: &mut (f64, usize),
-) {
-    let model = w.law;
-    // One material: its lanes once, not a table lookup per lane.
-    let single = w.pair_table.single().map(|m| PairMaterial::gather([m; LANES]));
-    let mut inputs = [QuadIn::<T>::default(); QUADS_PER_BLOCK];
-    let mut outputs = [QuadOut::<T>::default(); QUADS_PER_BLOCK];
-    let mut mats = [single.unwrap_or_default(); QUADS_PER_BLOCK];
-    let np = list.pairs.len();
-    let pairs = list.pairs.pairs();
-    const B: usize = QUADS_PER_BLOCK * LANES;
-    for (b, (kb, db)) in touching.chunks(B).zip(sep.chunks(B)).enumerate() {
-        let nq = kb.len() / LANES;
-        for q in 0..nq {
-            let s = q * LANES..(q + 1) * LANES;
-            inputs[q] = gather_quad(w, &list, &kb[s.clone()], &db[s], if single.is_none() { Some(&mut mats[q]) } else { None });
+    let v_rel = gather2(|l| {
+        let (vi, vj) = v.at(ks[l]);
+        vi - vj
+    });
+    let input = pair_input::<Lanes, T>(lever, d, ri, rj, wi, wj, v_rel, gather(|l| pc[l].r_star), gather(|l| pc[l].sqrt_m_star), Lanes::splat(w.dt));
+    let pm = match single {
+        Some(pm) => *pm,
+        None => {
+            let mat = list.pairs.of(&p.material);
+            PairMaterial::gather(std::array::from_fn(|l| {
+                let (mi, mj) = mat.at(ks[l]);
+                w.pair_table.get(mi as usize, mj as usize)
+            }))
         }
-        for q in 0..nq {
-            let (out, input, c) = quad_force(&model, w.dt, &inputs[q], &mats[q]);
-            outputs[q] = out;
-            // With the ledger, the energy terms too, in lanes; the ledger adds them later
-            // in list order.
-            if ENERGY {
-                let ks = &kb[q * LANES..(q + 1) * LANES];
-                let mut e = EnergyMemory::gather(std::array::from_fn(|l| &list.energy[ks[l] as usize]));
-                let t = model.energy_terms(input.n, input.dn, input.dt, &c, &mut e);
-                for l in 0..LANES {
-                    list.energy[ks[l] as usize] = e.lane(l);
-                    pending[b * B + q * LANES + l] = t.lane(l);
-                }
+    };
+    let mut h = T::gather(std::array::from_fn(|l| &hist[ks[l]]));
+    let c = model.force(&input, &pm, &mut h);
+    let torque = if T::FRICTION { pair_torque(lever, &input, c.tangential.elastic + c.tangential.damping, ri, rj) } else { [Lanes::splat(0.0); 2] };
+    let ratio = input.dn * gather(|l| pc[l].inv_r_min);
+    // The largest overlap so far: a lane beats it rarely, so one test per four pairs.
+    let beats = ratio.simd_gt(Lanes::splat(best.0)).bitmask();
+    if beats != 0 {
+        for (l, &k) in ks.iter().enumerate() {
+            if ratio.extract(l) > best.0 {
+                *best = (ratio.extract(l), k);
             }
         }
-        let (hist, active) = (&mut list.hist[..np], &mut list.active[..np]);
-        for (o, ks) in outputs[..nq].iter().zip(kb.chunks_exact(LANES)) {
-            // The largest overlap so far: a lane beats it rarely, so one test per four.
-            if o.ratio.simd_gt(Lanes::splat(best.0)).bitmask() != 0 {
-                for (l, &k) in ks.iter().enumerate() {
-                    if o.ratio.extract(l) > best.0 {
-                        *best = (o.ratio.extract(l), k as usize);
-                    }
-                }
-            }
-            for (l, &k) in ks.iter().enumerate() {
-                let k = k as usize;
-                hist[k] = T::lane(&o.h, l);
-                active[k] = true;
-                let [i, j] = pairs[k];
-                sink(k, (i as usize, j as usize), PairOut { force: lane2(&o.force, l), torque: [o.torque[0].extract(l), o.torque[1].extract(l)], ratio: o.ratio.extract(l) });
-            }
+    }
+    // With the ledger, the energy terms too, in lanes; the ledger adds them later in
+    // list order.
+    let terms = if ENERGY {
+        let mut e = EnergyMemory::gather(std::array::from_fn(|l| &list.energy[ks[l]]));
+        let t = model.energy_terms(input.n, input.dn, input.dt, &c, &mut e);
+        for (l, &k) in ks.iter().enumerate() {
+            list.energy[k] = e.lane(l);
+        }
+        t
+    } else {
+        EnergyTerms::default()
+    };
+    for l in 0..LANES {
+        hist[ks[l]] = T::lane(&h, l);
+        active[ks[l]] = true;
+        sink(ks[l], ij[l], PairOut { force: lane2(&c.force, l), torque: [torque[0].extract(l), torque[1].extract(l)], ratio: ratio.extract(l) });
+        if ENERGY {
+            pending[l] = terms.lane(l);
         }
     }
 }
@@ -674,9 +599,14 @@ pub fn compute_pairs<Dm: Damping, T: Tangential, const ENERGY: bool>(
         pending.resize(touching.len(), EnergyTerms::default());
     }
     let quads = touching.len() / LANES * LANES;
+    // One material: its lanes once, not a table lookup per lane.
+    let single = w.pair_table.single().map(|m| PairMaterial::gather([m; LANES]));
     let PairSlices { pairs, consts, hist, energy, active } = list;
-    let slices = PairSlices::<T> { pairs, consts, hist: &mut *hist, energy: &mut *energy, active: &mut *active };
-    touching_quads::<Dm, T, ENERGY>(w, slices, &touching[..quads], &sep[..quads], &mut sink, if ENERGY { &mut pending[..quads] } else { &mut [] }, &mut best);
+    let mut pend = pending.chunks_exact_mut(LANES);
+    for (ks, ds) in touching[..quads].chunks_exact(LANES).zip(sep.chunks_exact(LANES)) {
+        let slices = PairSlices::<T> { pairs, consts, hist: &mut *hist, energy: &mut *energy, active: &mut *active };
+        four_pairs::<Dm, T, ENERGY>(w, slices, single.as_ref(), ks, ds, &mut sink, if ENERGY { pend.next().expect("a slot per pair") } else { &mut [] }, &mut best);
+    }
     for (m, &k) in touching.iter().enumerate().skip(quads) {
         let k = k as usize;
         let [i, j] = pairs.pairs()[k].map(|g| g as usize);
