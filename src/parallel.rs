@@ -6,7 +6,9 @@
 //! pairs (g, j). The grains (stored along a Z curve, so index ranges are compact in space)
 //! are split into one index range per thread, balanced by the pairs' expected cost
 //! (listed pairs, the touching ones and the cross pairs below weighted: [`TOUCHING_COST`],
-//! [`CROSS_COST`]); the pairs whose
+//! [`CROSS_COST`]) and by how fast each thread got through its range's cost last time
+//! ([`rebalanced`]; the ranges are cut at each new list, and once [`FIRST_TIMING`] steps
+//! into the first); the pairs whose
 //! first grain is in a range are a contiguous part of the list, with their histories.
 //! The pairs that join two ranges ("cross" pairs; nearly all are free grains of the first
 //! range against the rough walls' grains, last in the index space) belong to the thread
@@ -31,6 +33,7 @@ use crate::sim::World;
 use crate::threads::Threads;
 use crate::dim::Vec2;
 use std::sync::OnceLock;
+use std::time::{Duration, Instant};
 
 /// What a touching pair costs the contact stage, in listed pairs: each listed pair is
 /// swept, each touching one also goes through the kernel. At 5000 grains on one thread
@@ -57,6 +60,9 @@ struct Scratch {
     worst: (f64, usize),
     /// What the thread's cross pairs did this step, in slot order.
     cross_out: Vec<PairOut>,
+    /// Time the thread worked in this stage since the ranges were last cut (not counting
+    /// waits for other threads).
+    busy: Duration,
 }
 
 /// Publishes an empty result if the thread unwinds before it publishes its own.
@@ -104,7 +110,18 @@ pub struct ParallelPairForces<const ENERGY: bool> {
     scratch: Vec<Scratch>,
     /// Neighbour-list build the tables belong to.
     built_for: u64,
+    /// Each range's share of the modelled cost ([`rebalanced`]), and the cost it got.
+    shares: Vec<f64>,
+    range_cost: Vec<usize>,
+    /// Steps since the ranges were cut, and whether they have been cut from timings yet.
+    since_cut: usize,
+    timed: bool,
 }
+
+/// Steps after which the ranges are cut again if the list lasts that long and they have
+/// not been cut from the threads' timings yet: the first list's cut is the cost model's
+/// alone, and a short run may not see a second list.
+const FIRST_TIMING: usize = 100;
 
 /// Where to cut the per-pair ledgers and energy memories for list parts cut at `bounds`:
 /// the same places with the energy ledger, else nowhere (they are empty).
@@ -155,21 +172,49 @@ fn range_of(g: usize, b: &[usize]) -> usize {
     b.partition_point(|&x| x <= g) - 1
 }
 
-/// Bounds of `t` grain ranges of about equal total cost (`cost` per grain).
-fn balanced(cost: &[usize], t: usize) -> Vec<usize> {
+/// Bounds of grain ranges, one per entry of `shares`, holding about those fractions of the
+/// total cost (`cost` per grain; the shares add up to 1).
+fn balanced(cost: &[usize], shares: &[f64]) -> Vec<usize> {
     let n = cost.len();
     let mut cumulative = vec![0usize; n + 1];
     for g in 0..n {
         cumulative[g + 1] = cumulative[g] + cost[g];
     }
     let mut bounds = vec![0];
-    for r in 1..t {
-        let target = cumulative[n] * r / t;
+    let mut before = 0.0;
+    for share in &shares[..shares.len() - 1] {
+        before += share;
+        let target = (cumulative[n] as f64 * before).round() as usize;
         let g = cumulative.partition_point(|&c| c < target).min(n);
         bounds.push(g.max(*bounds.last().unwrap()));
     }
     bounds.push(n);
     bounds
+}
+
+/// The shares of the modelled cost for the next cut's ranges, from the last cut's
+/// `shares`, what the cost model gave each range (`cost`) and how long each thread worked
+/// on its range since (`busy`). The cost model counts pairs; what a pair costs also
+/// depends on where it is: at 20 000 grains the second range had fewer of its listed pairs
+/// touching and its kernel took 11.1 ns per touching pair against the first range's 10.0
+/// (timed per thread), so equal modelled shares left the second thread 11% more work
+/// every step (0.823 s against 0.739 s of contact stage in 6000 steps). So each range gets
+/// the cost its thread did per second last time, as a share of what all did: equal times
+/// if the rates hold. No share rises by more than a quarter or falls by more than a fifth
+/// per cut, so that a thread descheduled for a while on a shared host cannot throw the
+/// next cut far off.
+/// The shares only move the cut between threads: the forces, and their bits, are the same
+/// for any cut.
+fn rebalanced(shares: &[f64], cost: &[usize], busy: &[Duration]) -> Vec<f64> {
+    if busy.iter().any(|b| b.is_zero()) || cost.contains(&0) {
+        return shares.to_vec();
+    }
+    // Cost per second of each thread: the equal-time shares are proportional to it.
+    let speed: Vec<f64> = cost.iter().zip(busy).map(|(&c, b)| c as f64 / b.as_secs_f64()).collect();
+    let total: f64 = speed.iter().sum();
+    let moved: Vec<f64> = shares.iter().zip(&speed).map(|(&s, &v)| (v / total).clamp(0.8 * s, 1.25 * s)).collect();
+    let sum: f64 = moved.iter().sum();
+    moved.iter().map(|s| s / sum).collect()
 }
 
 impl<const ENERGY: bool> ParallelPairForces<ENERGY> {
@@ -186,6 +231,10 @@ impl<const ENERGY: bool> ParallelPairForces<ENERGY> {
             ledgers: Vec::new(),
             scratch: (0..t).map(|_| Scratch::default()).collect(),
             built_for: u64::MAX,
+            shares: vec![1.0 / t as f64; t],
+            range_cost: vec![0; t],
+            since_cut: 0,
+            timed: false,
         }
     }
 
@@ -208,13 +257,20 @@ impl<const ENERGY: bool> ParallelPairForces<ENERGY> {
         // cost their thread more (they are sorted out one by one and read the grains of
         // another thread): cut once, count them, cut again.
         let t = self.scratch.len();
-        self.bounds = balanced(&cost, t);
+        let busy: Vec<Duration> = self.scratch.iter_mut().map(|s| std::mem::take(&mut s.busy)).collect();
+        if self.bounds.len() == self.shares.len() + 1 && *self.bounds.last().unwrap() == n {
+            self.shares = rebalanced(&self.shares, &self.range_cost, &busy);
+            self.timed = true;
+        }
+        self.since_cut = 0;
+        self.bounds = balanced(&cost, &self.shares);
         for p in pairs {
             if range_of(p[0] as usize, &self.bounds) != range_of(p[1] as usize, &self.bounds) {
                 cost[p[0] as usize] += CROSS_COST;
             }
         }
-        self.bounds = balanced(&cost, t);
+        self.bounds = balanced(&cost, &self.shares);
+        self.range_cost = self.bounds.windows(2).map(|b| cost[b[0]..b[1]].iter().sum()).collect();
         self.pair_bounds = self.bounds.iter().map(|&g| first[g]).collect();
         self.cross.clear();
         self.cross_in_part.clear();
@@ -243,7 +299,9 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
     fn run(&mut self, w: &mut World<ContactModel<Dm, T>>) -> Result<(), Error> {
         let n = w.p.len();
         let np = w.pairs.pairs.len();
-        if self.built_for != w.neighbours.builds || self.pair_bounds.last() != Some(&np) || *self.bounds.last().unwrap_or(&usize::MAX) != n {
+        self.since_cut += 1;
+        let first_timing = !self.timed && self.since_cut > FIRST_TIMING;
+        if first_timing || self.built_for != w.neighbours.builds || self.pair_bounds.last() != Some(&np) || *self.bounds.last().unwrap_or(&usize::MAX) != n {
             self.tables(n, &w.pairs.pairs, &w.pairs.active);
             self.built_for = w.neighbours.builds;
         }
@@ -270,8 +328,10 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
                 .zip(cut(&mut torque, bounds))
                 .zip(self.scratch.iter_mut());
             threads.each(parts.collect(), |r, (((((hist, active), (ledgers, energy)), fl), tl), sc)| {
+                let start = Instant::now();
+                let mut waited = Duration::ZERO;
                 let (g0, part) = (bounds[r], pb[r]..pb[r + 1]);
-                let Scratch { touching, sep, released, pending, worst, cross_out } = sc;
+                let Scratch { touching, sep, released, pending, worst, cross_out, busy } = sc;
                 // If this thread panics before it publishes, the others must not wait for it.
                 let _guard = Publish(&published[r]);
                 let mut none = EnergyLedger::default();
@@ -304,7 +364,15 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
                     let s = s as usize;
                     // The thread whose cross pairs hold slot s.
                     let from = range_of(s, cb);
-                    let o = &wait(&published[from])[s - cb[from]];
+                    let o = &match published[from].get() {
+                        Some(out) => out,
+                        None => {
+                            let t0 = Instant::now();
+                            let out = wait(&published[from]);
+                            waited += t0.elapsed();
+                            out
+                        }
+                    }[s - cb[from]];
                     if o.ratio > 0.0 {
                         let g = pairs[cross[s] as usize][1] as usize - g0;
                         fl[g] -= o.force;
@@ -342,6 +410,7 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
                     }
                 }
                 *worst = best;
+                *busy += start.elapsed().saturating_sub(waited);
             });
         }
         w.p.f = f;
@@ -370,5 +439,39 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
             }
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_cut_gives_each_range_its_share_of_the_cost() {
+        // Ten grains of cost 1 and one of cost 10 (20 in all): 30% is 6, reached with
+        // grain 5; a quarter is 5, reached with grain 4; half is 10, reached with grain 9.
+        let cost = [1, 1, 1, 1, 1, 1, 1, 1, 1, 10, 1];
+        assert_eq!(balanced(&cost, &[0.3, 0.7]), vec![0, 6, 11]);
+        assert_eq!(balanced(&cost, &[0.5, 0.5]), vec![0, 10, 11]);
+        assert_eq!(balanced(&cost, &[0.25, 0.25, 0.5]), vec![0, 5, 10, 11]);
+    }
+
+    #[test]
+    fn the_slower_thread_gets_less_cost_next_time() {
+        let ms = Duration::from_millis;
+        // Equal modelled cost, the second thread 10% slower: the shares go as the rates,
+        // 1 : 1/1.1.
+        let s = rebalanced(&[0.5, 0.5], &[1000, 1000], &[ms(100), ms(110)]);
+        approx::assert_relative_eq!(s[0], 1.1 / 2.1, max_relative = 1e-12);
+        approx::assert_relative_eq!(s[0] + s[1], 1.0, max_relative = 1e-12);
+        // Equal times: the shares stay.
+        let s = rebalanced(&[0.6, 0.4], &[1200, 800], &[ms(50), ms(50)]);
+        approx::assert_relative_eq!(s[0], 0.6, max_relative = 1e-12);
+        // A thread ten times slower (descheduled): a share rises by at most a quarter and
+        // falls by at most a fifth (0.5 to 0.625 and 0.4, then scaled to add up to 1).
+        let s = rebalanced(&[0.5, 0.5], &[1000, 1000], &[ms(10), ms(100)]);
+        approx::assert_relative_eq!(s[0], 0.625 / 1.025, max_relative = 1e-12);
+        // No timing yet: the shares stay.
+        assert_eq!(rebalanced(&[0.5, 0.5], &[1000, 1000], &[ms(0), ms(100)]), vec![0.5, 0.5]);
     }
 }
