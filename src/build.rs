@@ -380,7 +380,7 @@ impl Parts<'_> {
             if let Some(c) = scene.model.general_damping {
                 s.push(Box::new(GeneralDamping::<E>::new(c)));
             }
-            s.push(pair_stage::<Dm, T, E>(&threads));
+            s.push(if rotation { pair_stage::<Dm, T, E, true>(&threads) } else { pair_stage::<Dm, T, E, false>(&threads) });
             if has_flat {
                 s.push(Box::new(FlatWallForces::<E>));
             }
@@ -414,12 +414,13 @@ impl Parts<'_> {
     }
 }
 
-/// The grain-grain contact stage: serial, or on the run's pool of threads.
-fn pair_stage<Dm: Damping, T: Tangential, const E: bool>(threads: &crate::threads::Threads) -> Box<dyn Stage<ContactModel<Dm, T>>> {
+/// The grain-grain contact stage: serial, or on the run's pool of threads; with `SPIN` when
+/// the grains rotate (without, the kernel neither reads spins nor computes torques).
+fn pair_stage<Dm: Damping, T: Tangential, const E: bool, const SPIN: bool>(threads: &crate::threads::Threads) -> Box<dyn Stage<ContactModel<Dm, T>>> {
     #[cfg(feature = "parallel")]
     if threads.count() > 1 {
-        return Box::new(crate::parallel::ParallelPairForces::<E>::new(threads.clone()));
+        return Box::new(crate::parallel::ParallelPairForces::<E, SPIN>::new(threads.clone()));
     }
     let _ = threads;
-    Box::new(PairForces::<E>::default())
+    Box::new(PairForces::<E, SPIN>::default())
 }

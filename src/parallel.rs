@@ -91,7 +91,7 @@ fn wait<'b>(cell: &OnceLock<&'b [PairOut]>) -> &'b [PairOut] {
 }
 
 /// Grain-grain contacts on the run's thread pool.
-pub struct ParallelPairForces<const ENERGY: bool> {
+pub struct ParallelPairForces<const ENERGY: bool, const SPIN: bool> {
     threads: Threads,
     /// Grain index bounds of the ranges, `threads + 1` entries.
     bounds: Vec<usize>,
@@ -217,7 +217,7 @@ fn rebalanced(shares: &[f64], cost: &[usize], busy: &[Duration]) -> Vec<f64> {
     moved.iter().map(|s| s / sum).collect()
 }
 
-impl<const ENERGY: bool> ParallelPairForces<ENERGY> {
+impl<const ENERGY: bool, const SPIN: bool> ParallelPairForces<ENERGY, SPIN> {
     pub fn new(threads: Threads) -> Self {
         let t = threads.count();
         ParallelPairForces {
@@ -292,7 +292,7 @@ impl<const ENERGY: bool> ParallelPairForces<ENERGY> {
     }
 }
 
-impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> for ParallelPairForces<ENERGY> {
+impl<Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN: bool> Stage<ContactModel<Dm, T>> for ParallelPairForces<ENERGY, SPIN> {
     fn name(&self) -> String {
         format!("PairContacts(parallel, {} threads)", self.scratch.len())
     }
@@ -352,7 +352,7 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
                         }
                         cross_out[slot] = o;
                     };
-                    compute_pairs::<Dm, T, ENERGY>(&view, list, &touching[..nt], &sep[..nt], &released[..nr], ledgers.reborrow(), sink, pending);
+                    compute_pairs::<Dm, T, ENERGY, SPIN>(&view, list, &touching[..nt], &sep[..nt], &released[..nr], ledgers.reborrow(), sink, pending);
                 }
                 let own_cross: &[PairOut] = cross_out;
                 let _ = published[r].set(own_cross);
@@ -376,7 +376,7 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
                     if o.ratio > 0.0 {
                         let g = pairs[cross[s] as usize][1] as usize - g0;
                         fl[g] -= o.force;
-                        if T::FRICTION {
+                        if T::FRICTION && SPIN {
                             tl[g] -= o.torque[1];
                         }
                     }
@@ -385,18 +385,18 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
                 let list = PairSlices::<T> { pairs: checked.part(part.clone()), consts: &consts[part.clone()], hist, energy, active };
                 let mut add = |(i, j): (usize, usize), o: &PairOut, own: bool| {
                     fl[i - g0] += o.force;
-                    if T::FRICTION {
+                    if T::FRICTION && SPIN {
                         tl[i - g0] -= o.torque[0];
                     }
                     if own {
                         fl[j - g0] -= o.force;
-                        if T::FRICTION {
+                        if T::FRICTION && SPIN {
                             tl[j - g0] -= o.torque[1];
                         }
                     }
                 };
                 let sink = |_, ij: (usize, usize), o: PairOut| add(ij, &o, true);
-                let (ratio, kk) = compute_pairs::<Dm, T, ENERGY>(&view, list, &touching[..nt], &sep[..nt], &released[..nr], ledgers, sink, pending);
+                let (ratio, kk) = compute_pairs::<Dm, T, ENERGY, SPIN>(&view, list, &touching[..nt], &sep[..nt], &released[..nr], ledgers, sink, pending);
                 let mut best = if kk == usize::MAX { (0.0, usize::MAX) } else { (ratio, part.start + kk) };
                 // (5) Our cross pairs' forces on our grains: a grain's pairs (g, j) with j in
                 // a later range are the last of its sequence.

@@ -169,15 +169,16 @@ pub struct PairOut {
 }
 
 /// The contact input of touching pairs (one, or one per lane) from their separation
-/// `d` (minimum image, i minus j), radii, spins, relative velocity and constants.
+/// `d` (minimum image, i minus j), radii, spins (unread without `SPIN`: the grains do not
+/// rotate), relative velocity and constants.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-fn pair_input<R: Real, T: Tangential>(lever: LeverArm, d: Vector2<R>, ri: R, rj: R, wi: R, wj: R, v_rel: Vector2<R>, r_star: R, sqrt_m_star: R, dt: R) -> ContactInput<R> {
+fn pair_input<R: Real, T: Tangential, const SPIN: bool>(lever: LeverArm, d: Vector2<R>, ri: R, rj: R, wi: R, wj: R, v_rel: Vector2<R>, r_star: R, sqrt_m_star: R, dt: R) -> ContactInput<R> {
     let radsum = ri + rj;
     let r = d.norm_squared().simd_sqrt();
     let n = d * r.simd_recip();
     let dn = radsum - r;
-    let spin = if T::FRICTION { lever.arm(ri, dn) * wi + lever.arm(rj, dn) * wj } else { R::zero() };
+    let spin = if T::FRICTION && SPIN { lever.arm(ri, dn) * wi + lever.arm(rj, dn) * wj } else { R::zero() };
     let tangential_scale = if T::FRICTION { lever.translation_scale(radsum, dn) } else { R::one() };
     ContactInput { n, dn, r_star, sqrt_m_star, v_rel, spin, dt, tangential_scale }
 }
@@ -220,7 +221,7 @@ pub fn pair_contact<Dm: Damping, T: Tangential, const ENERGY: bool>(
         }
         return PairOut::default();
     }
-    let (o, pend) = one_pair(w, (i, j), d, pc, h, active);
+    let (o, pend) = one_pair::<Dm, T, true>(w, (i, j), d, pc, h, active);
     if ENERGY {
         model.account(pend.n, pend.dn, w.dt, &pend.state, e, ledger);
     }
@@ -230,10 +231,11 @@ pub fn pair_contact<Dm: Damping, T: Tangential, const ENERGY: bool>(
 /// Four touching pairs at once, one per SIMD lane (`ks`: their indices in the list, `ds`
 /// their separations): the same bits as [`one_pair`] gives each of them, handed to
 /// `sink` (index in the part, grains, output) in lane order; with `ENERGY`, their energy
-/// terms (also in lanes, their energy memories moved on) go to `pending`.
+/// terms (also in lanes, their energy memories moved on) go to `pending`. Without `SPIN`
+/// (grains that do not rotate) the spins are not read and the torques not computed.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-fn four_pairs<Dm: Damping, T: Tangential, const ENERGY: bool>(
+fn four_pairs<Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN: bool>(
     w: &PairView<'_, ContactModel<Dm, T>>,
     list: PairSlices<'_, T>,
     single: Option<&PairMaterial<Lanes>>,
@@ -259,7 +261,7 @@ fn four_pairs<Dm: Damping, T: Tangential, const ENERGY: bool>(
     let d = gather2(|l| ds[l]);
     let rs: [(f64, f64); LANES] = std::array::from_fn(|l| r.at(ks[l]));
     let (ri, rj) = (gather(|l| rs[l].0), gather(|l| rs[l].1));
-    let (wi, wj) = if T::FRICTION {
+    let (wi, wj) = if T::FRICTION && SPIN {
         let ws: [(f64, f64); LANES] = std::array::from_fn(|l| omega.at(ks[l]));
         (gather(|l| ws[l].0), gather(|l| ws[l].1))
     } else {
@@ -269,7 +271,7 @@ fn four_pairs<Dm: Damping, T: Tangential, const ENERGY: bool>(
         let (vi, vj) = v.at(ks[l]);
         vi - vj
     });
-    let input = pair_input::<Lanes, T>(lever, d, ri, rj, wi, wj, v_rel, gather(|l| pc[l].r_star), gather(|l| pc[l].sqrt_m_star), Lanes::splat(w.dt));
+    let input = pair_input::<Lanes, T, SPIN>(lever, d, ri, rj, wi, wj, v_rel, gather(|l| pc[l].r_star), gather(|l| pc[l].sqrt_m_star), Lanes::splat(w.dt));
     let pm = match single {
         Some(pm) => *pm,
         None => {
@@ -282,7 +284,7 @@ fn four_pairs<Dm: Damping, T: Tangential, const ENERGY: bool>(
     };
     let mut h = T::gather(std::array::from_fn(|l| &hist[ks[l]]));
     let c = model.force(&input, &pm, &mut h);
-    let torque = if T::FRICTION { pair_torque(lever, &input, c.tangential.elastic + c.tangential.damping, ri, rj) } else { [Lanes::splat(0.0); 2] };
+    let torque = if T::FRICTION && SPIN { pair_torque(lever, &input, c.tangential.elastic + c.tangential.damping, ri, rj) } else { [Lanes::splat(0.0); 2] };
     let ratio = input.dn * gather(|l| pc[l].inv_r_min);
     // The largest overlap so far: a lane beats it rarely, so one test per four pairs.
     let beats = ratio.simd_gt(Lanes::splat(best.0)).bitmask();
@@ -318,7 +320,7 @@ fn four_pairs<Dm: Damping, T: Tangential, const ENERGY: bool>(
 /// One touching pair of grains `(i, j)` at separation `d` (minimum image, i minus j):
 /// its force, advancing its tangential state `h`, and what its energy accounting needs.
 #[inline(always)]
-fn one_pair<Dm: Damping, T: Tangential>(
+fn one_pair<Dm: Damping, T: Tangential, const SPIN: bool>(
     w: &PairView<'_, ContactModel<Dm, T>>,
     (i, j): (usize, usize),
     d: Vec2,
@@ -328,11 +330,11 @@ fn one_pair<Dm: Damping, T: Tangential>(
 ) -> (PairOut, Touch) {
     let (model, p) = (w.law, w.p);
     let lever = model.options.lever_arm;
-    let input = pair_input::<f64, T>(lever, d, p.r[i], p.r[j], p.omega[i], p.omega[j], p.v[i] - p.v[j], pc.r_star, pc.sqrt_m_star, w.dt);
+    let input = pair_input::<f64, T, SPIN>(lever, d, p.r[i], p.r[j], p.omega[i], p.omega[j], p.v[i] - p.v[j], pc.r_star, pc.sqrt_m_star, w.dt);
     let pm = w.pair_table.get(p.material[i] as usize, p.material[j] as usize);
     let c = model.force(&input, pm, h);
     *active = true;
-    let torque = if T::FRICTION { pair_torque(lever, &input, c.tangential.elastic + c.tangential.damping, p.r[i], p.r[j]) } else { [0.0, 0.0] };
+    let torque = if T::FRICTION && SPIN { pair_torque(lever, &input, c.tangential.elastic + c.tangential.damping, p.r[i], p.r[j]) } else { [0.0, 0.0] };
     (PairOut { force: c.force, torque, ratio: input.dn * pc.inv_r_min }, Touch { n: input.n, dn: input.dn, state: c })
 }
 
@@ -584,7 +586,7 @@ fn sweep(x: &[Vec2], boundary: &Boundary, pairs: CheckedPairs<'_>, reach: &[f64]
 /// smaller radius of the touching pairs and the index (in the part) of the first pair
 /// that has it, `(0, usize::MAX)` if none touches.
 #[allow(clippy::too_many_arguments)]
-pub fn compute_pairs<Dm: Damping, T: Tangential, const ENERGY: bool>(
+pub fn compute_pairs<Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN: bool>(
     w: &PairView<'_, ContactModel<Dm, T>>,
     list: PairSlices<'_, T>,
     touching: &[u32],
@@ -605,12 +607,12 @@ pub fn compute_pairs<Dm: Damping, T: Tangential, const ENERGY: bool>(
     let mut pend = pending.chunks_exact_mut(LANES);
     for (ks, ds) in touching[..quads].chunks_exact(LANES).zip(sep.chunks_exact(LANES)) {
         let slices = PairSlices::<T> { pairs, consts, hist: &mut *hist, energy: &mut *energy, active: &mut *active };
-        four_pairs::<Dm, T, ENERGY>(w, slices, single.as_ref(), ks, ds, &mut sink, if ENERGY { pend.next().expect("a slot per pair") } else { &mut [] }, &mut best);
+        four_pairs::<Dm, T, ENERGY, SPIN>(w, slices, single.as_ref(), ks, ds, &mut sink, if ENERGY { pend.next().expect("a slot per pair") } else { &mut [] }, &mut best);
     }
     for (m, &k) in touching.iter().enumerate().skip(quads) {
         let k = k as usize;
         let [i, j] = pairs.pairs()[k].map(|g| g as usize);
-        let (o, p) = one_pair(w, (i, j), sep[m], &consts[k], &mut hist[k], &mut active[k]);
+        let (o, p) = one_pair::<Dm, T, SPIN>(w, (i, j), sep[m], &consts[k], &mut hist[k], &mut active[k]);
         if o.ratio > best.0 {
             best = (o.ratio, k);
         }
@@ -655,16 +657,17 @@ pub struct PairView<'a, L: ContactLaw> {
 /// Grain-grain contacts over the Verlet list, in two passes: a branch-free sweep sorts
 /// out the pairs that are touching (and those just released), then the kernel runs on
 /// those only, four at a time in SIMD lanes. Most listed pairs are not touching (the
-/// skin): the sweep spares them the kernel.
+/// skin): the sweep spares them the kernel. `SPIN`: the grains rotate (the pairs' torques
+/// are computed and collected).
 #[derive(Default)]
-pub struct PairForces<const ENERGY: bool> {
+pub struct PairForces<const ENERGY: bool, const SPIN: bool> {
     touching: Vec<u32>,
     sep: Vec<Vec2>,
     released: Vec<u32>,
     pending: Vec<EnergyTerms>,
 }
 
-impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> for PairForces<ENERGY> {
+impl<Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN: bool> Stage<ContactModel<Dm, T>> for PairForces<ENERGY, SPIN> {
     fn name(&self) -> String {
         "PairContacts".into()
     }
@@ -683,12 +686,12 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
         let sink = |_, (i, j): (usize, usize), o: PairOut| {
             fs[i] += o.force;
             fs[j] -= o.force;
-            if T::FRICTION {
+            if T::FRICTION && SPIN {
                 ts[i] -= o.torque[0];
                 ts[j] -= o.torque[1];
             }
         };
-        let (ratio, k) = compute_pairs::<Dm, T, ENERGY>(&view, list, touching, sep, released, Ledgers::One(&mut w.ledger), sink, &mut self.pending);
+        let (ratio, k) = compute_pairs::<Dm, T, ENERGY, SPIN>(&view, list, touching, sep, released, Ledgers::One(&mut w.ledger), sink, &mut self.pending);
         if ratio > worst.0 {
             let [i, j] = pairs.pairs()[k];
             worst = (ratio, i as usize, j as usize);
