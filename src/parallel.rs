@@ -74,11 +74,17 @@ impl Drop for Publish<'_, '_> {
     }
 }
 
-/// What another thread published, once it has (it does so early in its step).
-fn wait<'b>(cell: &OnceLock<&'b [PairOut]>) -> &'b [PairOut] {
+/// What another thread published, once it has (it does so early in its step); the time
+/// spent waiting for it is added to `waited`.
+fn wait<'b>(cell: &OnceLock<&'b [PairOut]>, waited: &mut Duration) -> &'b [PairOut] {
+    if let Some(v) = cell.get() {
+        return v;
+    }
+    let start = Instant::now();
     let mut spins = 0u32;
     loop {
         if let Some(v) = cell.get() {
+            *waited += start.elapsed();
             return v;
         }
         spins += 1;
@@ -364,15 +370,7 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN: bool> Stage<Con
                     let s = s as usize;
                     // The thread whose cross pairs hold slot s.
                     let from = range_of(s, cb);
-                    let o = &match published[from].get() {
-                        Some(out) => out,
-                        None => {
-                            let t0 = Instant::now();
-                            let out = wait(&published[from]);
-                            waited += t0.elapsed();
-                            out
-                        }
-                    }[s - cb[from]];
+                    let o = &wait(&published[from], &mut waited)[s - cb[from]];
                     if o.ratio > 0.0 {
                         let g = pairs[cross[s] as usize][1] as usize - g0;
                         fl[g] -= o.force;
