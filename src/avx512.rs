@@ -122,18 +122,19 @@ impl GrainPart<'_> {
 /// the caller wraps them and watches again). Eight grains at a time in two registers
 /// per vector array, (x, y) pairs as they are stored: the portable loop splits the pairs
 /// into x and y registers and back, and that shuffling, not memory, bounded it. Returns
-/// (grains done, far, outside).
-pub fn drift<const ROT: bool>(g: GrainPart<'_>, x: &mut [Vec2], at: &[Vec2], dt: f64, boundary: &Boundary, limit: f64) -> (usize, bool, bool) {
+/// (grains done, far, outside). With `TWICE`, the last step's final half kick first
+/// (the same kick, with the same forces, once more before it: the bits of two passes).
+pub fn drift<const ROT: bool, const TWICE: bool>(g: GrainPart<'_>, x: &mut [Vec2], at: &[Vec2], dt: f64, boundary: &Boundary, limit: f64) -> (usize, bool, bool) {
     let end = g.eights::<ROT>().min(x.len()).min(at.len());
     // SAFETY: the module is compiled only for AVX-512F; every array is read or written
     // below `end` grains.
-    let (far, out) = unsafe { drift_eights::<ROT>(end, g, x.as_mut_ptr() as *mut f64, at.as_ptr() as *const f64, dt, boundary, limit) };
+    let (far, out) = unsafe { drift_eights::<ROT, TWICE>(end, g, x.as_mut_ptr() as *mut f64, at.as_ptr() as *const f64, dt, boundary, limit) };
     (end, far, out)
 }
 
 /// The loop of [`drift`] over `end` grains (a multiple of eight).
 #[target_feature(enable = "avx512f")]
-unsafe fn drift_eights<const ROT: bool>(end: usize, g: GrainPart<'_>, x: *mut f64, at: *const f64, dt: f64, boundary: &Boundary, limit: f64) -> (bool, bool) {
+unsafe fn drift_eights<const ROT: bool, const TWICE: bool>(end: usize, g: GrainPart<'_>, x: *mut f64, at: *const f64, dt: f64, boundary: &Boundary, limit: f64) -> (bool, bool) {
     let (v, f, m) = (g.v.as_mut_ptr() as *mut f64, g.f.as_mut_ptr() as *mut f64, g.dtfm.as_ptr());
     let (w, t, mi) = (g.omega.as_mut_ptr(), g.torque.as_mut_ptr(), g.dtfi.as_ptr());
     let (lo, hi) = (_mm512_setr_epi64(0, 0, 1, 1, 2, 2, 3, 3), _mm512_setr_epi64(4, 4, 5, 5, 6, 6, 7, 7));
@@ -154,6 +155,9 @@ unsafe fn drift_eights<const ROT: bool>(end: usize, g: GrainPart<'_>, x: *mut f6
             let m8 = _mm512_loadu_pd(m.add(k));
             for (h, idx) in [(0, lo), (1, hi)] {
                 let o = 2 * k + 8 * h;
+                if TWICE {
+                    kick_four(v, f, m8, idx, o);
+                }
                 let vv = kick_four(v, f, m8, idx, o);
                 _mm512_storeu_pd(f.add(o), _mm512_setzero_pd());
                 let xx = _mm512_add_pd(_mm512_loadu_pd(x.add(o)), _mm512_mul_pd(dtv, vv));
@@ -176,6 +180,9 @@ unsafe fn drift_eights<const ROT: bool>(end: usize, g: GrainPart<'_>, x: *mut f6
                 }
             }
             if ROT {
+                if TWICE {
+                    kick_spins(w, t, mi, k);
+                }
                 kick_spins(w, t, mi, k);
                 _mm512_storeu_pd(t.add(k), _mm512_setzero_pd());
             }
@@ -279,6 +286,18 @@ mod tests {
                 for (limit, far_somewhere) in [(1e-6, true), (0.25, true), (1.0, false)] {
                     let (mut v, f, dtfm, mut omega, torque, dtfi, mut x, at) = grains(n, seed);
                     let (mut v0, mut x0, mut omega0) = (v.clone(), x.clone(), omega.clone());
+                    // The fused pending kick: two kicks, as two passes give them.
+                    let (mut v2, mut x2, mut omega2) = (v.clone(), x.clone(), omega.clone());
+                    let mut used = (f.clone(), torque.clone());
+                    let (done2, ..) = drift::<true, true>(GrainPart { v: &mut v2, f: &mut used.0, dtfm: &dtfm, omega: &mut omega2, torque: &mut used.1, dtfi: &dtfi }, &mut x2, &at, dt, &boundary, limit);
+                    let (mut v2_want, mut x2_want, mut omega2_want) = (v.clone(), x.clone(), omega.clone());
+                    for k in 0..done2 {
+                        v2_want[k] += dtfm[k] * f[k];
+                        v2_want[k] += dtfm[k] * f[k];
+                        x2_want[k] += dt * v2_want[k];
+                        omega2_want[k] += dtfi[k] * torque[k];
+                        omega2_want[k] += dtfi[k] * torque[k];
+                    }
                     for k in 0..n {
                         v0[k] += dtfm[k] * f[k];
                         x0[k] += dt * v0[k];
@@ -286,7 +305,7 @@ mod tests {
                     }
                     let (far0, out0) = (Neighbours::moved(&x0, &at, &boundary, limit), boundary.any_outside(&x0));
                     let (mut used_f, mut used_t) = (f.clone(), torque.clone());
-                    let (done, far, out) = drift::<true>(GrainPart { v: &mut v, f: &mut used_f, dtfm: &dtfm, omega: &mut omega, torque: &mut used_t, dtfi: &dtfi }, &mut x, &at, dt, &boundary, limit);
+                    let (done, far, out) = drift::<true, false>(GrainPart { v: &mut v, f: &mut used_f, dtfm: &dtfm, omega: &mut omega, torque: &mut used_t, dtfi: &dtfi }, &mut x, &at, dt, &boundary, limit);
                     assert_eq!(done, n / WIDTH * WIDTH);
                     // The forces and torques used are zero, the rest untouched.
                     assert!(used_f[..done].iter().all(|f| *f == Vec2::zeros()) && used_t[..done].iter().all(|&t| t == 0.0));
@@ -296,6 +315,8 @@ mod tests {
                     assert_eq!(bits(&v), bits(&v0), "v, n = {n}");
                     assert_eq!(bits(&x), bits(&x0), "x, n = {n}");
                     assert_eq!(spin_bits(&omega), spin_bits(&omega0), "spins, n = {n}");
+                    assert_eq!(done2, done);
+                    assert_eq!((bits(&v2), bits(&x2), spin_bits(&omega2)), (bits(&v2_want), bits(&x2_want), spin_bits(&omega2_want)), "twice, n = {n}");
                     // The eights' findings are those of the same grains' portable watch.
                     assert_eq!(far, Neighbours::moved(&x0[..done], &at[..done], &boundary, limit), "far, n = {n}, limit {limit}");
                     assert_eq!(out, boundary.any_outside(&x0[..done]), "outside, n = {n}");

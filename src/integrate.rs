@@ -137,15 +137,15 @@ impl<L: ContactLaw, const ROT: bool> Stage<L> for InitialIntegrate<ROT> {
             let (torque, tg) = torque.split_at_mut(nf);
             let (at, atg) = at.split_at(nf);
             // Where the build has AVX-512, eight grains at a time first (the same bits),
-            // after the pending kick in a pass of its own.
+            // with the pending kick in the same pass.
             #[cfg(all(target_arch = "x86_64", target_feature = "avx512f", target_feature = "avx512vl", target_feature = "avx512bw"))]
-            let (from, mut far_here, out, twice) = {
-                if twice {
-                    kick_part::<ROT>(&mut *v, &mut *f, (dtfm, dtfm2), &mut *omega, &mut *torque, dtfi);
-                }
+            let (from, mut far_here, out) = {
                 let g = crate::avx512::GrainPart { v: &mut *v, f: &mut *f, dtfm, omega: &mut *omega, torque: &mut *torque, dtfi };
-                let (from, far, out) = crate::avx512::drift::<ROT>(g, &mut *x, at, dt, &b, limit);
-                (from, far, out, false)
+                if twice {
+                    crate::avx512::drift::<ROT, true>(g, &mut *x, at, dt, &b, limit)
+                } else {
+                    crate::avx512::drift::<ROT, false>(g, &mut *x, at, dt, &b, limit)
+                }
             };
             #[cfg(not(all(target_arch = "x86_64", target_feature = "avx512f", target_feature = "avx512vl", target_feature = "avx512bw")))]
             let (from, mut far_here, out) = (0, false, false);
