@@ -89,8 +89,9 @@ impl KickFactors {
 ///
 /// The rough walls' grains follow their walls in the same pass ([`Glued::follow`]; the
 /// walls themselves have moved in [`crate::pipeline::MoveWalls`] just before), on the
-/// thread that owns them in the contact stage: its cache has them, and a serial stage
-/// would have to fetch them from there.
+/// last thread, whose part of the grains ends with them: no serial stage of their own.
+/// (In the contact stage the first thread adds their forces; moving their zeroing to it,
+/// in `ClearForces`, timed the same at 100 000 grains.)
 #[derive(Default)]
 pub struct InitialIntegrate<const ROT: bool> {
     /// Stands in for the positions at the last build before there is a build.

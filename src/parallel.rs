@@ -3,25 +3,38 @@
 //! Floating-point sums depend on their order, so the parallel stage keeps the serial
 //! order of every addition. The Verlet list is sorted with i < j in each pair, and the
 //! serial loop adds to a grain g first its pairs (m, g), m < g, in list order, then its
-//! pairs (g, j). The grains (stored along a Z curve, so index ranges are compact in space)
-//! are split into one index range per thread, balanced by the pairs' expected cost
+//! pairs (g, j). The free grains (stored along a Z curve, so index ranges are compact in
+//! space) are split into one index range per thread, balanced by the pairs' expected cost
 //! (listed pairs, the touching ones and the cross pairs below weighted: [`TOUCHING_COST`],
 //! [`CROSS_COST`]) and by how fast each thread got through its range's cost last time
 //! ([`rebalanced`]; the ranges are cut at each new list, and once [`FIRST_TIMING`] steps
-//! into the first); the pairs whose
-//! first grain is in a range are a contiguous part of the list, with their histories.
-//! The pairs that join two ranges ("cross" pairs; nearly all are free grains of the first
-//! range against the rough walls' grains, last in the index space) belong to the thread
-//! of their first grain. In one hand-over per step, each thread (1) computes its cross
-//! pairs and publishes what they did, (2) sorts out the touching pairs of the rest of its
-//! part, (3) adds to its grains the cross pairs from earlier ranges (they are first in
-//! every grain's sequence; it waits for their threads to publish, which they do first
-//! thing), (4) computes its touching pairs four at a time, adding each result as it
-//! comes, in list order, and (5) adds its own cross pairs to their first grains: a
-//! grain's pairs (g, j) with j in a later range have the largest j, so they are the last
-//! of its sequence. Then the energy terms are merged in list order and the largest
-//! overlap picked as the serial loop would. `tests/parallel.rs` checks identical bits
-//! with 1 and 2 threads.
+//! into the first); the pairs whose first grain is in a range are a contiguous part of
+//! the list, with their histories.
+//!
+//! The rough walls' grains come last in the index space and own no pairs; every range
+//! has pairs with them. They belong to the first thread: their sequences begin with the
+//! first range's pairs, which it adds as they come, and the other threads keep what their
+//! pairs do to those grains, in list order, for the first thread to add after its own.
+//! The pairs that join two ranges of free grains ("cross" pairs, a few along each cut)
+//! belong to the thread of their first grain.
+//!
+//! In one hand-over per step, each thread (1) computes its cross pairs and publishes what
+//! they did, (2) sorts out the touching pairs of the rest of its part, (3) adds to its
+//! grains the cross pairs from earlier ranges (they are first in every grain's sequence;
+//! it waits for their threads to publish, which they do first thing), (4) computes its
+//! touching pairs four at a time, adding each result as it comes, in list order (or
+//! keeping it, for a wall's grain on a thread after the first), (5) adds its own cross
+//! pairs to their first grains: a grain's pairs (g, j) with j in a later range have the
+//! largest j, so they are the last of its sequence, and publishes what it kept for the
+//! walls' grains; (6) the first thread adds those, range by range. Then the energy terms
+//! are merged in list order and the largest overlap picked as the serial loop would.
+//! `tests/parallel.rs` checks identical bits with 1, 2 and 3 threads.
+//!
+//! Were the walls' grains the last thread's (as in the per-grain stages), the other
+//! ranges' pairs with them would be cross pairs: at 100 000 grains about 2500 a step on
+//! the first thread, which took it 58 ms per 1000 steps to compute apart and 9 ms to add,
+//! and the last thread 25-29 ms to add to the walls' grains. Owned by the first thread,
+//! the threads' summed time in the stage is 2-4% lower (timed per thread).
 
 use crate::contact::ContactModel;
 use crate::contact::damping::Damping;
@@ -49,6 +62,25 @@ const TOUCHING_COST: usize = 8;
 /// (timed per thread), against about 5 ns for a listed pair in the sweep and kernel.
 const CROSS_COST: usize = 10;
 
+/// What a pair did to a rough wall's grain (`o.grain` counted from the first wall grain):
+/// added to that grain (`walls`: the first thread's forces and torques of those grains,
+/// and with `torque` the torque too) or kept for the first thread (`out`). Out of line:
+/// about one touching pair in 40 reaches a wall's grain, and the kernel's loop kept the
+/// sink inline only while it was small (with this code inline, each thread took 25% longer).
+#[cold]
+#[inline(never)]
+fn to_wall(torque: bool, walls: &mut Option<(&mut [Vec2], &mut [f64])>, out: &mut Vec<WallOut>, o: WallOut) {
+    match walls {
+        Some((fw, tw)) => {
+            fw[o.grain as usize] -= o.force;
+            if torque {
+                tw[o.grain as usize] -= o.torque;
+            }
+        }
+        None => out.push(o),
+    }
+}
+
 /// One thread's working lists.
 #[derive(Default)]
 struct Scratch {
@@ -60,15 +92,26 @@ struct Scratch {
     worst: (f64, usize),
     /// What the thread's cross pairs did this step, in slot order.
     cross_out: Vec<PairOut>,
+    /// What the thread's pairs did to rough walls' grains this step, in list order (the
+    /// threads after the first: the first owns those grains).
+    wall_out: Vec<WallOut>,
     /// Time the thread worked in this stage since the ranges were last cut (not counting
     /// waits for other threads).
     busy: Duration,
 }
 
-/// Publishes an empty result if the thread unwinds before it publishes its own.
-struct Publish<'a, 'b>(&'a OnceLock<&'b [PairOut]>);
+/// What a pair did to its second grain, a rough wall's grain.
+#[derive(Clone, Copy)]
+struct WallOut {
+    grain: u32,
+    force: Vec2,
+    torque: f64,
+}
 
-impl Drop for Publish<'_, '_> {
+/// Publishes an empty result if the thread unwinds before it publishes its own.
+struct Publish<'a, 'b, X>(&'a OnceLock<&'b [X]>);
+
+impl<X> Drop for Publish<'_, '_, X> {
     fn drop(&mut self) {
         let _ = self.0.set(&[]);
     }
@@ -76,7 +119,7 @@ impl Drop for Publish<'_, '_> {
 
 /// What another thread published, once it has (it does so early in its step); the time
 /// spent waiting for it is added to `waited`.
-fn wait<'b>(cell: &OnceLock<&'b [PairOut]>, waited: &mut Duration) -> &'b [PairOut] {
+fn wait<'b, X>(cell: &OnceLock<&'b [X]>, waited: &mut Duration) -> &'b [X] {
     if let Some(v) = cell.get() {
         return v;
     }
@@ -99,8 +142,11 @@ fn wait<'b>(cell: &OnceLock<&'b [PairOut]>, waited: &mut Duration) -> &'b [PairO
 /// Grain-grain contacts on the run's thread pool.
 pub struct ParallelPairForces<const ENERGY: bool, const SPIN: bool> {
     threads: Threads,
-    /// Grain index bounds of the ranges, `threads + 1` entries.
+    /// Grain index bounds of the ranges of free grains, `threads + 1` entries (the last
+    /// is `n_free`; the rough walls' grains after it belong to the first thread).
     bounds: Vec<usize>,
+    /// Number of grains the tables were made for.
+    grains: usize,
     /// Pair index bounds of the ranges' parts of the list.
     pair_bounds: Vec<usize>,
     /// The pairs joining two ranges, in list order (a pair's slot is its place here),
@@ -229,6 +275,7 @@ impl<const ENERGY: bool, const SPIN: bool> ParallelPairForces<ENERGY, SPIN> {
         ParallelPairForces {
             threads,
             bounds: Vec::new(),
+            grains: 0,
             pair_bounds: Vec::new(),
             cross: Vec::new(),
             cross_in_part: Vec::new(),
@@ -246,7 +293,7 @@ impl<const ENERGY: bool, const SPIN: bool> ParallelPairForces<ENERGY, SPIN> {
 
     /// The ranges and the cross pairs for a new list (`active`: which of its pairs touched
     /// at the last step).
-    fn tables(&mut self, n: usize, pairs: &[[u32; 2]], active: &[bool]) {
+    fn tables(&mut self, n: usize, n_free: usize, pairs: &[[u32; 2]], active: &[bool]) {
         // Per grain: the pairs it is first in (cumulative), and their expected cost.
         let (mut first, mut cost) = (vec![0usize; n + 1], vec![0usize; n]);
         for (p, &a) in pairs.iter().zip(active) {
@@ -257,25 +304,32 @@ impl<const ENERGY: bool, const SPIN: bool> ParallelPairForces<ENERGY, SPIN> {
         for g in 0..n {
             first[g + 1] += first[g];
         }
-        // Ranges with about the same cost each (the grains of rough walls, last in the
-        // index space, own no pairs). They stay close to the equal ranges of the per-grain
-        // stages, so that each thread mostly works on the same grains. The cross pairs
-        // cost their thread more (they are sorted out one by one and read the grains of
-        // another thread): cut once, count them, cut again.
+        // Ranges of free grains with about the same cost each (the grains of rough walls,
+        // last in the index space, own no pairs). They stay close to the equal ranges of
+        // the per-grain stages, so that each thread mostly works on the same grains. The
+        // cross pairs cost their thread more (they are sorted out one by one and read the
+        // grains of another thread): cut once, count them, cut again.
         let t = self.scratch.len();
         let busy: Vec<Duration> = self.scratch.iter_mut().map(|s| std::mem::take(&mut s.busy)).collect();
-        if self.bounds.len() == self.shares.len() + 1 && *self.bounds.last().unwrap() == n {
+        if self.bounds.len() == self.shares.len() + 1 && self.grains == n && *self.bounds.last().unwrap() == n_free {
             self.shares = rebalanced(&self.shares, &self.range_cost, &busy);
             self.timed = true;
         }
         self.since_cut = 0;
-        self.bounds = balanced(&cost, &self.shares);
-        for p in pairs {
-            if range_of(p[0] as usize, &self.bounds) != range_of(p[1] as usize, &self.bounds) {
-                cost[p[0] as usize] += CROSS_COST;
+        // A range's pairs are those whose first grain it holds (the list is sorted), and
+        // the second grain comes later: it is in a later range if it is past the range's
+        // end and a free grain.
+        let cost = &mut cost[..n_free];
+        let first_cut = balanced(cost, &self.shares);
+        for b in first_cut.windows(2) {
+            for p in &pairs[first[b[0]]..first[b[1]]] {
+                if (b[1]..n_free).contains(&(p[1] as usize)) {
+                    cost[p[0] as usize] += CROSS_COST;
+                }
             }
         }
-        self.bounds = balanced(&cost, &self.shares);
+        self.bounds = balanced(cost, &self.shares);
+        self.grains = n;
         self.range_cost = self.bounds.windows(2).map(|b| cost[b[0]..b[1]].iter().sum()).collect();
         self.pair_bounds = self.bounds.iter().map(|&g| first[g]).collect();
         self.cross.clear();
@@ -283,10 +337,11 @@ impl<const ENERGY: bool, const SPIN: bool> ParallelPairForces<ENERGY, SPIN> {
         self.cross_bounds = vec![0];
         self.incoming = vec![Vec::new(); t];
         for r in 0..t {
-            let k0 = self.pair_bounds[r];
+            let (k0, end) = (self.pair_bounds[r], self.bounds[r + 1]);
             for (m, p) in pairs[k0..self.pair_bounds[r + 1]].iter().enumerate() {
-                let rj = range_of(p[1] as usize, &self.bounds);
-                if rj != r {
+                // (Pairs with a rough wall's grain are not cross pairs: see `run`.)
+                if (end..n_free).contains(&(p[1] as usize)) {
+                    let rj = range_of(p[1] as usize, &self.bounds);
                     let slot = self.cross.len() as u32;
                     self.cross_in_part.push(m as u32);
                     self.cross.push((k0 + m) as u32);
@@ -303,12 +358,12 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN: bool> Stage<Con
         format!("PairContacts(parallel, {} threads)", self.scratch.len())
     }
     fn run(&mut self, w: &mut World<ContactModel<Dm, T>>) -> Result<(), Error> {
-        let n = w.p.len();
+        let (n, n_free) = (w.p.len(), w.p.n_free);
         let np = w.pairs.pairs.len();
         self.since_cut += 1;
         let first_timing = !self.timed && self.since_cut > FIRST_TIMING;
-        if first_timing || self.built_for != w.neighbours.builds || self.pair_bounds.last() != Some(&np) || *self.bounds.last().unwrap_or(&usize::MAX) != n {
-            self.tables(n, &w.pairs.pairs, &w.pairs.active);
+        if first_timing || self.built_for != w.neighbours.builds || self.pair_bounds.last() != Some(&np) || self.grains != n {
+            self.tables(n, n_free, &w.pairs.pairs, &w.pairs.active);
             self.built_for = w.neighbours.builds;
         }
         self.ledgers.clear();
@@ -326,20 +381,28 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN: bool> Stage<Con
             // What each thread computed of its cross pairs, for the threads of their second
             // grains to read once it is there.
             let published: Vec<OnceLock<&[PairOut]>> = (0..self.scratch.len()).map(|_| OnceLock::new()).collect();
+            // ... and what each thread after the first did to the rough walls' grains.
+            let published_walls: Vec<OnceLock<&[WallOut]>> = (0..self.scratch.len()).map(|_| OnceLock::new()).collect();
+            // The free grains' forces and torques in one part per range, the walls' grains'
+            // (after the last range) to the first thread.
+            let grain_bounds: Vec<usize> = bounds.iter().copied().chain([n]).collect();
+            let (mut f_parts, mut torque_parts) = (cut(&mut f, &grain_bounds), cut(&mut torque, &grain_bounds));
+            let mut walls = f_parts.pop().zip(torque_parts.pop());
             let parts = cut(&mut w.pairs.hist, pb)
                 .into_iter()
                 .zip(cut(&mut w.pairs.active, pb))
                 .zip(cut(&mut self.ledgers, &ledger_bounds).into_iter().zip(cut(&mut w.pairs.energy, &ledger_bounds)))
-                .zip(cut(&mut f, bounds))
-                .zip(cut(&mut torque, bounds))
-                .zip(self.scratch.iter_mut());
-            threads.each(parts.collect(), |r, (((((hist, active), (ledgers, energy)), fl), tl), sc)| {
+                .zip(f_parts.into_iter().zip(torque_parts))
+                .zip(self.scratch.iter_mut())
+                .enumerate()
+                .map(|(r, p)| (p, if r == 0 { walls.take() } else { None }));
+            threads.each(parts.collect(), |r, (((((hist, active), (ledgers, energy)), (fl, tl)), sc), mut walls)| {
                 let start = Instant::now();
                 let mut waited = Duration::ZERO;
                 let (g0, part) = (bounds[r], pb[r]..pb[r + 1]);
-                let Scratch { touching, sep, released, pending, worst, cross_out, busy } = sc;
+                let Scratch { touching, sep, released, pending, worst, cross_out, wall_out, busy } = sc;
                 // If this thread panics before it publishes, the others must not wait for it.
-                let _guard = Publish(&published[r]);
+                let _guard = (Publish(&published[r]), Publish(&published_walls[r]));
                 let mut none = EnergyLedger::default();
                 let mut ledgers = if ENERGY { Ledgers::PerPair(ledgers) } else { Ledgers::One(&mut none) };
                 // (1) Our cross pairs first, as the serial stage does its pairs: sort out the
@@ -379,17 +442,24 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN: bool> Stage<Con
                         }
                     }
                 }
-                // (4) Our pairs, each force to its grains as the kernel hands it over.
+                // (4) Our pairs, each force to its grains as the kernel hands it over; a rough
+                // wall's grain belongs to the first thread, so the others keep what they do
+                // to one for it, in list order.
                 let list = PairSlices::<T> { pairs: checked.part(part.clone()), consts: &consts[part.clone()], hist, energy, active };
+                wall_out.clear();
                 let mut add = |(i, j): (usize, usize), o: &PairOut, own: bool| {
                     fl[i - g0] += o.force;
                     if T::FRICTION && SPIN {
                         tl[i - g0] -= o.torque[0];
                     }
                     if own {
-                        fl[j - g0] -= o.force;
-                        if T::FRICTION && SPIN {
-                            tl[j - g0] -= o.torque[1];
+                        if j < n_free {
+                            fl[j - g0] -= o.force;
+                            if T::FRICTION && SPIN {
+                                tl[j - g0] -= o.torque[1];
+                            }
+                        } else {
+                            to_wall(T::FRICTION && SPIN, &mut walls, wall_out, WallOut { grain: (j - n_free) as u32, force: o.force, torque: o.torque[1] });
                         }
                     }
                 };
@@ -404,6 +474,20 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN: bool> Stage<Con
                         add((pairs[k][0] as usize, pairs[k][1] as usize), oc, false);
                         if oc.ratio > best.0 || (oc.ratio == best.0 && k < best.1) {
                             best = (oc.ratio, k);
+                        }
+                    }
+                }
+                let _ = published_walls[r].set(wall_out);
+                // (6) The first thread: what the later ranges' pairs did to the rough walls'
+                // grains, after its own (their pairs come later in the list).
+                if let Some((fw, tw)) = &mut walls {
+                    for from in &published_walls[1..] {
+                        for o in wait(from, &mut waited) {
+                            let g = o.grain as usize;
+                            fw[g] -= o.force;
+                            if T::FRICTION && SPIN {
+                                tw[g] -= o.torque;
+                            }
                         }
                     }
                 }

@@ -138,7 +138,7 @@ impl Threads {
 
     /// `f(range, part)` on one part of `0..n` per thread, as [`Threads::split`] shares them
     /// but with the last thread taking all grains from `n_free` on (the rough walls'
-    /// grains, which it owns in the contact stage too); `range` is the part's place in
+    /// grains, which follow their walls there); `range` is the part's place in
     /// `0..n`. The arrays of `part` may stop short of `n`
     /// (those of the free grains only): the last part has what is left of them.
     pub fn split_free<P: Split>(&self, n_free: usize, n: usize, part: P, f: impl Fn(std::ops::Range<usize>, P) + Sync) {
