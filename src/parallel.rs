@@ -71,12 +71,7 @@ const CROSS_COST: usize = 10;
 #[inline(never)]
 fn to_wall(torque: bool, walls: &mut Option<(&mut [Vec2], &mut [f64])>, out: &mut Vec<WallOut>, o: WallOut) {
     match walls {
-        Some((fw, tw)) => {
-            fw[o.grain as usize] -= o.force;
-            if torque {
-                tw[o.grain as usize] -= o.torque;
-            }
-        }
+        Some((fw, tw)) => o.onto(fw, tw, torque),
         None => out.push(o),
     }
 }
@@ -106,6 +101,28 @@ struct WallOut {
     grain: u32,
     force: Vec2,
     torque: f64,
+}
+
+impl WallOut {
+    /// Add it to its grain's force in `fw` (and with `torque` its torque in `tw`): the
+    /// first thread's parts for the walls' grains.
+    #[inline(always)]
+    fn onto(&self, fw: &mut [Vec2], tw: &mut [f64], torque: bool) {
+        let g = self.grain as usize;
+        fw[g] -= self.force;
+        if torque {
+            tw[g] -= self.torque;
+        }
+    }
+}
+
+/// Whether a pair of a range ending at grain `end` whose second grain is `j` joins it to
+/// a later range: the list is sorted, so a range's pairs are those whose first grain it
+/// holds and the second grain comes later; it is in a later range if it is past the
+/// range's end and a free grain (pairs with a rough wall's grain are not cross pairs: see
+/// the module's notes).
+fn joins_later_range(j: u32, end: usize, n_free: usize) -> bool {
+    (end..n_free).contains(&(j as usize))
 }
 
 /// Publishes an empty result if the thread unwinds before it publishes its own.
@@ -316,14 +333,11 @@ impl<const ENERGY: bool, const SPIN: bool> ParallelPairForces<ENERGY, SPIN> {
             self.timed = true;
         }
         self.since_cut = 0;
-        // A range's pairs are those whose first grain it holds (the list is sorted), and
-        // the second grain comes later: it is in a later range if it is past the range's
-        // end and a free grain.
         let cost = &mut cost[..n_free];
         let first_cut = balanced(cost, &self.shares);
         for b in first_cut.windows(2) {
             for p in &pairs[first[b[0]]..first[b[1]]] {
-                if (b[1]..n_free).contains(&(p[1] as usize)) {
+                if joins_later_range(p[1], b[1], n_free) {
                     cost[p[0] as usize] += CROSS_COST;
                 }
             }
@@ -339,8 +353,7 @@ impl<const ENERGY: bool, const SPIN: bool> ParallelPairForces<ENERGY, SPIN> {
         for r in 0..t {
             let (k0, end) = (self.pair_bounds[r], self.bounds[r + 1]);
             for (m, p) in pairs[k0..self.pair_bounds[r + 1]].iter().enumerate() {
-                // (Pairs with a rough wall's grain are not cross pairs: see `run`.)
-                if (end..n_free).contains(&(p[1] as usize)) {
+                if joins_later_range(p[1], end, n_free) {
                     let rj = range_of(p[1] as usize, &self.bounds);
                     let slot = self.cross.len() as u32;
                     self.cross_in_part.push(m as u32);
@@ -483,11 +496,7 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN: bool> Stage<Con
                 if let Some((fw, tw)) = &mut walls {
                     for from in &published_walls[1..] {
                         for o in wait(from, &mut waited) {
-                            let g = o.grain as usize;
-                            fw[g] -= o.force;
-                            if T::FRICTION && SPIN {
-                                tw[g] -= o.torque;
-                            }
+                            o.onto(fw, tw, T::FRICTION && SPIN);
                         }
                     }
                 }
