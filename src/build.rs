@@ -236,7 +236,6 @@ pub fn build_with(scene: &Scene, threads: usize) -> Result<Built, Error> {
 
     // Walls.
     let mut walls = Vec::new();
-    let mut wall_material = 0;
     if let Some(ws) = &scene.walls {
         let top_of_grains = (0..n_free).map(|i| p.x[i].y + p.r[i]).fold(f64::NEG_INFINITY, f64::max);
         let x0 = boundary.is_periodic().then_some(boundary.x_min).unwrap_or_else(|| p.x.iter().map(|x| x.x).fold(f64::INFINITY, f64::min));
@@ -247,10 +246,7 @@ pub fn build_with(scene: &Scene, threads: usize) -> Result<Built, Error> {
             };
             let y = spec.y.unwrap_or(top_of_grains + rough_r);
             let surface = match spec.surface {
-                SurfaceSpec::Flat => {
-                    wall_material = spec.material;
-                    Surface::Flat
-                }
+                SurfaceSpec::Flat => Surface::Flat,
                 SurfaceSpec::Rough { radius } => {
                     let count = ((length / (2.0 * radius)).floor() as usize).max(1);
                     let start = p.len();
@@ -278,6 +274,7 @@ pub fn build_with(scene: &Scene, threads: usize) -> Result<Built, Error> {
                 x_shift: 0.0,
                 v: Vec2::new(spec.velocity_x, 0.0),
                 mass,
+                material: spec.material,
                 force: Vec2::zeros(),
                 force_prev: Vec2::zeros(),
             });
@@ -290,8 +287,9 @@ pub fn build_with(scene: &Scene, threads: usize) -> Result<Built, Error> {
     let (r, m, i) = (p.r[imin], p.m[imin], p.inertia[imin]);
     let mat = &mats[p.material[imin] as usize];
     let mut refs = vec![RefContact { r_star: r / 2.0, m_star: m / 2.0, pair: PairMaterial::mix(mat, mat), inv_tangential_mass: 2.0 / m + 2.0 * r * r / i }];
-    if walls.iter().any(|w: &Wall| w.is_flat()) {
-        refs.push(RefContact { r_star: r, m_star: m, pair: PairMaterial::mix(mat, &mats[wall_material]), inv_tangential_mass: 1.0 / m + r * r / i });
+    // Against each flat wall, with the wall's own material.
+    for w in walls.iter().filter(|w: &&Wall| w.is_flat()) {
+        refs.push(RefContact { r_star: r, m_star: m, pair: PairMaterial::mix(mat, &mats[w.material]), inv_tangential_mass: 1.0 / m + r * r / i });
     }
     let _ = reduced;
     let ts = &scene.time_step;
@@ -310,7 +308,7 @@ pub fn build_with(scene: &Scene, threads: usize) -> Result<Built, Error> {
     let options = ModelOptions { limit_force: scene.model.limit_force, lever_arm: scene.model.lever_arm };
     let all_elastic = mats.iter().all(|m| m.restitution == 1.0);
     let threads = crate::threads::Threads::new(threads)?;
-    let parts = Parts { p, boundary, walls, wall_material, dt: time_step.dt_s, skin, scene, threads };
+    let parts = Parts { p, boundary, walls, dt: time_step.dt_s, skin, scene, threads };
     let engine: Box<dyn Engine> = match (scene.model.tangential, all_elastic) {
         (TangentialSpec::Frictionless, false) => parts.assemble(HertzFrictionless::new(options))?,
         (TangentialSpec::Frictionless, true) => parts.assemble(HertzFrictionlessElastic::new(options))?,
@@ -326,7 +324,6 @@ struct Parts<'a> {
     p: Particles,
     boundary: Boundary,
     walls: Vec<Wall>,
-    wall_material: usize,
     dt: f64,
     skin: f64,
     scene: &'a Scene,
@@ -353,7 +350,6 @@ impl Parts<'_> {
             boundary: self.boundary,
             law,
             pair_table: PairTable::new(&scene.materials),
-            wall_material: self.wall_material,
             pairs: PairList { keep_energy: E, ..Default::default() },
             walls: self.walls,
             wall_hist,

@@ -740,7 +740,7 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
                 let ai = if T::FRICTION { lever.arm(ri, dn) } else { 0.0 };
                 let spin = if T::FRICTION { ai * p.omega[i] } else { 0.0 };
                 let input = ContactInput { n, dn, r_star: ri, sqrt_m_star: p.m[i].sqrt(), v_rel: p.v[i] - wall.v, spin, dt, tangential_scale: 1.0 };
-                let pm = w.pair_table.get(p.material[i] as usize, w.wall_material);
+                let pm = w.pair_table.get(p.material[i] as usize, wall.material);
                 let c = model.touch::<ENERGY>(&input, pm, h, &mut w.ledger);
                 active[i] = true;
                 p.f[i] += c.force;

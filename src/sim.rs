@@ -23,8 +23,6 @@ pub struct World<L: ContactLaw> {
     pub boundary: Boundary,
     pub law: L,
     pub pair_table: PairTable,
-    /// Material index of flat walls.
-    pub wall_material: usize,
     pub pairs: PairList<<L::Tang as Tangential>::History<f64>>,
     pub walls: Vec<Wall>,
     /// History of each free grain against each flat wall: `wall_hist[wall][grain]`.

@@ -44,6 +44,9 @@ pub struct Wall {
     pub v: Vec2,
     /// Mass that the load accelerates, kg.
     pub mass: f64,
+    /// Material index of the wall's surface (a flat wall's contacts mix it with the
+    /// grain's; a rough wall's glued grains carry it themselves).
+    pub material: usize,
     /// Force of the grains on the wall at this step, N.
     pub force: Vec2,
     /// ... and at the previous step.
