@@ -341,80 +341,16 @@ pub fn cell_pairs(
     if n < 2 {
         return Vec::new();
     }
-    let r_max = r.iter().cloned().fold(0.0, f64::max);
-    let cell = 2.0 * r_max + skin;
-    let (mut lo, mut hi) = (Vec2::repeat(f64::INFINITY), Vec2::repeat(f64::NEG_INFINITY));
-    for p in x {
-        lo = lo.inf(p);
-        hi = hi.sup(p);
-    }
-    let periodic = boundary.is_periodic();
-    let (x0, lx) = if periodic { (boundary.x_min, boundary.period) } else { (lo.x, (hi.x - lo.x).max(cell)) };
-    let ly = (hi.y - lo.y).max(cell);
-    let mut nx = ((lx / cell).floor() as usize).max(1);
-    if periodic && nx < 3 {
-        nx = 1;
-    }
-    let ny = ((ly / cell).floor() as usize).max(1);
-    // Keep the grid modest for sparse systems (a few grains far apart).
-    let max_cells = 4 * n + 64;
-    let (nx, ny) = if nx * ny > max_cells {
-        let s = ((nx * ny) as f64 / max_cells as f64).sqrt().ceil() as usize;
-        let nx2 = (nx / s).max(1);
-        (if periodic && nx2 < 3 { 1 } else { nx2 }, (ny / s).max(1))
-    } else {
-        (nx, ny)
-    };
-    let (wx, wy) = (lx / nx as f64, ly / ny as f64);
-    let cell_of = |p: &Vec2| -> usize {
-        let mut xr = p.x - x0;
-        if periodic {
-            xr -= lx * (xr / lx).floor();
-        }
-        let cx = ((xr / wx) as usize).min(nx - 1);
-        let cy = (((p.y - lo.y) / wy).max(0.0) as usize).min(ny - 1);
-        cy * nx + cx
-    };
-    let cells: Vec<u32> = x.iter().map(|p| cell_of(p) as u32).collect();
-    bin_into_cells(&cells, nx * ny, cell_start, cell_items);
-    let (cell_start, cell_items) = (&cell_start[..], &cell_items[..]);
+    let cells = CellList::new(x, r, boundary, skin, cell_start, cell_items);
     // Each grain with the grains of higher index in its cell and the eight around it.
     let pairs_of = |i: usize, out: &mut Vec<[u32; 2]>| {
-        let c = cells[i] as usize;
-        let (cx, cy) = ((c % nx) as isize, (c / nx) as isize);
-        let mut around = [0usize; 9];
-        let mut m = 0;
-        for oy in -1..=1 {
-            let y = cy + oy;
-            if y < 0 || y >= ny as isize {
-                continue;
-            }
-            for ox in -1..=1 {
-                let mut xx = cx + ox;
-                if xx < 0 || xx >= nx as isize {
-                    if !periodic {
-                        continue;
-                    }
-                    xx = xx.rem_euclid(nx as isize);
-                }
-                around[m] = y as usize * nx + xx as usize;
-                m += 1;
-            }
-        }
-        let around = &mut around[..m];
-        around.sort_unstable();
         let start = out.len();
-        for (k, &d) in around.iter().enumerate() {
-            if k > 0 && around[k - 1] == d {
-                continue;
+        cells.candidates(i, |j| {
+            if j > i && (i < n_free || j < n_free) && listed(boundary.image(x[i] - x[j]), r[i], r[j], skin) {
+                out.push([i as u32, j as u32]);
             }
-            for &j in &cell_items[cell_start[d] as usize..cell_start[d + 1] as usize] {
-                let j = j as usize;
-                if j > i && (i < n_free || j < n_free) && listed(boundary.image(x[i] - x[j]), r[i], r[j], skin) {
-                    out.push([i as u32, j as u32]);
-                }
-            }
-        }
+            true
+        });
         out[start..].sort_unstable();
     };
     let bounds = threads.bounds(n);
@@ -429,6 +365,160 @@ pub fn cell_pairs(
         return parts.pop().unwrap_or_default();
     }
     parts.concat()
+}
+
+/// The pair (i < j, not both wall grains) whose overlap is the largest fraction of the
+/// smaller radius, with that fraction: `None` when no pair overlaps. Stops at the first
+/// pair above `stop` (a scene's grains may all sit at one point: listing the
+/// overlapping pairs could take n^2 memory, this never takes more than the cell list).
+pub fn largest_overlap(x: &[Vec2], r: &[f64], n_free: usize, boundary: &Boundary, stop: f64) -> Option<(usize, usize, f64)> {
+    if x.len() < 2 {
+        return None;
+    }
+    let (mut cs, mut ci) = (Vec::new(), Vec::new());
+    let cells = CellList::new(x, r, boundary, 0.0, &mut cs, &mut ci);
+    let mut worst: Option<(usize, usize, f64)> = None;
+    for i in 0..x.len() {
+        let mut go_on = true;
+        cells.candidates(i, |j| {
+            if j > i && (i < n_free || j < n_free) {
+                let ratio = (r[i] + r[j] - boundary.image(x[i] - x[j]).norm()) / r[i].min(r[j]);
+                if ratio > 0.0 && worst.is_none_or(|w| ratio > w.2) {
+                    worst = Some((i, j, ratio));
+                    go_on = ratio <= stop;
+                }
+            }
+            go_on
+        });
+        if !go_on {
+            break;
+        }
+    }
+    worst
+}
+
+/// A cell list: square-ish cells at least one contact reach (`2 r_max + skin`) wide over
+/// the grains' bounding box, so that a grain's partners are in its cell or the eight
+/// around it. Dense (a counting sort into a grid) when the grid has no more cells than a
+/// few per grain, which a packing always has; sparse (the grains sorted by cell, cells
+/// found by bisection) when the grains are spread far apart, so that neither memory nor
+/// time depends on how far apart they are.
+struct CellList<'a> {
+    periodic: bool,
+    /// Columns and rows of the grid (rows up to 2^31 in the sparse case).
+    nx: u64,
+    ny: u64,
+    /// The cell of each grain, `cy * nx + cx`.
+    cell: Vec<u64>,
+    kind: Cells<'a>,
+}
+
+enum Cells<'a> {
+    /// The grains of cell c are `items[start[c]..start[c + 1]]`.
+    Dense { start: &'a [u32], items: &'a [u32] },
+    /// The cells of the grains in order (`keys`) and the grains in that order (`items`).
+    Sparse { keys: Vec<u64>, items: Vec<u32> },
+}
+
+/// Most cells of a dense grid for `n` grains.
+fn max_dense_cells(n: usize) -> f64 {
+    (4 * n + 64) as f64
+}
+
+/// Most columns or rows a grid counts (2^31): grains beyond share the edge cells.
+const MAX_CELLS_PER_AXIS: f64 = 2147483648.0;
+
+impl<'a> CellList<'a> {
+    fn new(x: &[Vec2], r: &[f64], boundary: &Boundary, skin: f64, cell_start: &'a mut Vec<u32>, cell_items: &'a mut Vec<u32>) -> Self {
+        let n = x.len();
+        let r_max = r.iter().cloned().fold(0.0, f64::max);
+        let reach = 2.0 * r_max + skin;
+        let (mut lo, mut hi) = (Vec2::repeat(f64::INFINITY), Vec2::repeat(f64::NEG_INFINITY));
+        for p in x {
+            lo = lo.inf(p);
+            hi = hi.sup(p);
+        }
+        let periodic = boundary.is_periodic();
+        let (x0, lx) = if periodic { (boundary.x_min, boundary.period) } else { (lo.x, (hi.x - lo.x).max(reach)) };
+        let ly = (hi.y - lo.y).max(reach);
+        // In floating point: the counts of a far-flung set of grains do not fit an integer.
+        let count = |l: f64| {
+            let c = (l / reach).floor();
+            if c.is_finite() { c.clamp(1.0, MAX_CELLS_PER_AXIS) } else { MAX_CELLS_PER_AXIS }
+        };
+        let (mut fx, fy) = (count(lx), count(ly));
+        // A periodic row of fewer than three cells would meet itself: one cell then.
+        if periodic && fx < 3.0 {
+            fx = 1.0;
+        }
+        let (nx, ny) = (fx as u64, fy as u64);
+        let (wx, wy) = (lx / fx, ly / fy);
+        let cell_of = |p: &Vec2| -> u64 {
+            let mut xr = p.x - x0;
+            if periodic {
+                xr -= lx * (xr / lx).floor();
+            }
+            // `as` saturates (and takes NaN to 0): every grain gets a cell of the grid.
+            let cx = ((xr / wx) as u64).min(nx - 1);
+            let cy = (((p.y - lo.y) / wy).max(0.0) as u64).min(ny - 1);
+            cy * nx + cx
+        };
+        let cell: Vec<u64> = x.iter().map(cell_of).collect();
+        let kind = if fx * fy <= max_dense_cells(n) {
+            let as_u32: Vec<u32> = cell.iter().map(|&c| c as u32).collect();
+            bin_into_cells(&as_u32, (nx * ny) as usize, cell_start, cell_items);
+            Cells::Dense { start: &cell_start[..], items: &cell_items[..] }
+        } else {
+            let mut order: Vec<u32> = (0..n as u32).collect();
+            order.sort_unstable_by_key(|&i| (cell[i as usize], i));
+            Cells::Sparse { keys: order.iter().map(|&i| cell[i as usize]).collect(), items: order }
+        };
+        CellList { periodic, nx, ny, cell, kind }
+    }
+
+    /// Call `visit` with each grain of grain i's cell and the eight around it (i
+    /// included), each cell once, until it returns false.
+    #[inline]
+    fn candidates(&self, i: usize, mut visit: impl FnMut(usize) -> bool) {
+        let c = self.cell[i];
+        let (cx, cy) = ((c % self.nx) as i64, (c / self.nx) as i64);
+        let (nx, ny) = (self.nx as i64, self.ny as i64);
+        let mut around = [0u64; 9];
+        let mut m = 0;
+        for oy in -1..=1 {
+            let y = cy + oy;
+            if y < 0 || y >= ny {
+                continue;
+            }
+            for ox in -1..=1 {
+                let mut xx = cx + ox;
+                if xx < 0 || xx >= nx {
+                    if !self.periodic {
+                        continue;
+                    }
+                    xx = xx.rem_euclid(nx);
+                }
+                around[m] = (y * nx + xx) as u64;
+                m += 1;
+            }
+        }
+        let around = &mut around[..m];
+        around.sort_unstable();
+        for (k, &d) in around.iter().enumerate() {
+            if k > 0 && around[k - 1] == d {
+                continue;
+            }
+            let grains = match &self.kind {
+                Cells::Dense { start, items } => &items[start[d as usize] as usize..start[d as usize + 1] as usize],
+                Cells::Sparse { keys, items } => &items[keys.partition_point(|&key| key < d)..keys.partition_point(|&key| key <= d)],
+            };
+            for &j in grains {
+                if !visit(j as usize) {
+                    return;
+                }
+            }
+        }
+    }
 }
 
 #[cfg(test)]

@@ -34,6 +34,28 @@ proptest! {
     }
 }
 
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(200))]
+    /// A few grains flung far away (up to 1e6 box sizes, in x and y): the grid would need
+    /// far more cells than grains, so the cell list sorts the grains by cell instead of
+    /// binning them into a dense grid; it must still find exactly the pairs brute force
+    /// finds (and near the flung grains, which may touch each other, too).
+    #[test]
+    fn cell_list_equals_brute_force_with_grains_far_apart((x, r, n_free, _, skin) in packing(), far in prop::collection::vec((0usize..250, -6.0f64..6.0, -6.0f64..6.0), 1..4)) {
+        let mut x = x;
+        let side = x.iter().map(|p| p.x).fold(0.0, f64::max) + 1e-9;
+        for (k, (i, ex, ey)) in far.iter().enumerate() {
+            let i = i % x.len();
+            // Two flung grains may land together: the second next to the first.
+            x[i] = if k == 1 { x[far[0].0 % x.len()] + Vec2::new(r[i], 0.0) } else { Vec2::new(side * 10f64.powf(*ex), side * 10f64.powf(*ey)) };
+        }
+        let b = Boundary::open();
+        let brute = brute_force_pairs(&x, &r, n_free, &b, skin);
+        let cells = cell_pairs(&x, &r, n_free, &b, skin, &mut Vec::new(), &mut Vec::new(), &Threads::serial());
+        prop_assert_eq!(cells, brute);
+    }
+}
+
 /// One contact's random state: overlap, normal angle, velocities, spin, history.
 fn contact() -> impl Strategy<Value = [f64; 9]> {
     // Overlaps from 1e-9 to 1e-4 of a 0.5 mm grain; speeds up to 1 m/s; the history
