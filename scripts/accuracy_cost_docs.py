@@ -29,7 +29,8 @@ def sweep(path, steps, extra=()):
     out = os.path.join(TMP, os.path.basename(path) + ".csv")
     print("sweep", os.path.basename(path), steps, *extra, flush=True)
     sh("sweep", path, "--steps", ",".join(str(s) for s in steps), "--out", out, *extra)
-    return [{k: (float(v) if k not in ("variant", "rule") else v) for k, v in r.items()} for r in csv.DictReader(open(out))]
+    # An empty cell is a quantity that does not apply to the row (NaN here).
+    return [{k: (float(v) if v != "" else float("nan")) if k not in ("variant", "rule") else v for k, v in r.items()} for r in csv.DictReader(open(out))]
 
 
 def steps_per_contact(path, s, rule):

@@ -8,15 +8,18 @@ use crate::contact::model::*;
 use crate::contact::tangential::Tangential;
 use crate::contact::{ContactHistory, ContactLaw, ContactModel, ModelOptions};
 use crate::dim::Vec2;
-use crate::error::Error;
+use crate::error::{Error, Shown};
 use crate::integrate::{FinalIntegrate, InitialIntegrate};
-use crate::material::{PairMaterial, PairTable, reduced};
+use crate::material::{PairMaterial, PairTable};
 use crate::neighbor::{Neighbours, PairList};
 use crate::observe::energy::{EnergyLedger, EnergyRow};
 use crate::pack::relaxed_packing;
 use crate::particles::Particles;
 use crate::pipeline::*;
-use crate::scene::{ControlSpec, Grains, Scene, SurfaceSpec, TangentialSpec, TimeStepRule};
+use crate::consistency::{self, GrainNames, MAX_PACKING_OVERLAP, MAX_START_OVERLAP, MAX_STEP_MOVE};
+use crate::domain::{Context, Domain};
+use crate::limits::{Limits, MemoryEstimate};
+use crate::scene::{Analysis, ControlSpec, GrainColumns, Grains, Scene, SurfaceSpec, TangentialSpec, TimeStepRule};
 use crate::sim::{Simulation, World};
 use crate::timestep::{RefContact, TimeStepInfo, choose};
 use crate::walls::{Control, Surface, Wall};
@@ -135,28 +138,40 @@ impl Built {
     }
 }
 
-fn read_particle_file(path: &str) -> Result<Vec<(Vec2, f64)>, Error> {
-    let text = std::fs::read_to_string(path).map_err(|e| Error::io(format!("grains.file.path = {path}"), e))?;
+/// The grains of a particle file: one per line in the declared `columns`, `#` starts a
+/// comment; with the line of each grain, for messages. The file is read up to the
+/// budget's file size ([`Limits::file_bytes`]).
+/// A grain file's grains (centre, radius) and the line of each.
+type FileGrains = (Vec<(Vec2, f64)>, Vec<u32>);
+
+fn read_particle_file(path: &str, columns: GrainColumns, limits: &Limits) -> Result<FileGrains, Error> {
+    let text = crate::limits::read_bounded(std::path::Path::new(path), limits.file_bytes(), "grains.file.path")?;
     let mut out = Vec::new();
+    let mut lines = Vec::new();
     for (k, line) in text.lines().enumerate() {
         let line = line.split('#').next().unwrap_or("").trim();
         if line.is_empty() {
             continue;
         }
-        let v: Result<Vec<f64>, _> = line.split_whitespace().map(str::parse).collect();
-        let bad = || Error::Scene(format!("{path}:{}: expected `x y r` or `x y z r` in m, got `{line}`", k + 1));
-        let v = v.map_err(|_| bad())?;
-        let (x, y, r) = match v.as_slice() {
-            [x, y, r] => (*x, *y, *r),
-            [x, y, _z, r] => (*x, *y, *r),
-            _ => return Err(bad()),
-        };
-        if !(r > 0.0 && x.is_finite() && y.is_finite()) {
-            return Err(bad());
+        let bad = |why: &str| Error::Scene(format!("{path}:{}: {why}: `{line}` (grains.file.columns = \"{}\", in m)", k + 1, columns.name()));
+        let v: Vec<f64> = line.split_whitespace().map(str::parse).collect::<Result<_, _>>().map_err(|_| bad("not a number"))?;
+        if v.len() != columns.count() {
+            return Err(bad(&format!("{} numbers where the columns are {}", v.len(), columns.count())));
+        }
+        let (x, y, r) = (v[0], v[1], v[columns.count() - 1]);
+        if !(r.is_finite() && r > 0.0) {
+            return Err(bad("the radius must be > 0"));
+        }
+        if !(x.is_finite() && y.is_finite()) {
+            return Err(bad("the position must be finite"));
         }
         out.push((Vec2::new(x, y), r));
+        lines.push((k + 1) as u32);
     }
-    Ok(out)
+    if out.is_empty() {
+        return Err(Error::Invalid { field: "grains.file.path".into(), value: path.into(), allowed: "a file with at least one grain".into() });
+    }
+    Ok((out, lines))
 }
 
 /// Build the engine a scene describes.
@@ -165,67 +180,138 @@ pub fn build(scene: &Scene) -> Result<Built, Error> {
 }
 
 /// Build with the contact forces on `threads` threads (feature `parallel`; results are
-/// bit-identical to one thread).
+/// bit-identical to one thread), within the machine's default [`Limits`].
 pub fn build_with(scene: &Scene, threads: usize) -> Result<Built, Error> {
+    build_limited(scene, threads, &Limits::machine())
+}
+
+/// The number of grains a rough wall of glued grains of `radius` holds over `length`.
+fn glued_count(length: f64, radius: f64) -> f64 {
+    (length / (2.0 * radius)).floor().max(1.0)
+}
+
+/// Build within `limits`: every size is estimated from the scene and checked against the
+/// memory budget before it is allocated, and the grains, walls and time step are checked
+/// for consistency ([`crate::consistency`]) before the engine is.
+pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<Built, Error> {
     crate::threads::Threads::check_count(threads, 1)?;
     scene.validate()?;
     let shape = scene.grain_shape;
     let mats = &scene.materials;
+    let boundary = match scene.domain.periodic_x {
+        Some([a, b]) => Boundary::periodic_x(a, b - a),
+        None => Boundary::open(),
+    };
+    // How many grains, before any is made: a file is read (within the budget's file
+    // size) to count them.
+    let file = match &scene.grains {
+        Grains::File { path, columns, .. } => Some(read_particle_file(path, *columns, limits)?),
+        _ => None,
+    };
+    let (count, count_field, count_value) = match &scene.grains {
+        Grains::List(list) => (list.len() as u64, "grains.list".to_string(), format!("{} grains", list.len())),
+        Grains::File { path, .. } => (file.as_ref().map_or(0, |f| f.0.len()) as u64, "grains.file.path".to_string(), format!("{path} ({} grains)", file.as_ref().map_or(0, |f| f.0.len()))),
+        Grains::Pack(spec) => (spec.count as u64, "grains.pack.count".to_string(), spec.count.to_string()),
+    };
+    // The x length the rough walls span: the periodic cell, the packing's region, or the
+    // listed grains' extent.
+    let mut length = boundary.period;
+    if length == 0.0 {
+        length = match (&scene.grains, &file) {
+            (Grains::Pack(spec), _) => spec.x[1] - spec.x[0],
+            (Grains::List(list), _) => extent(list.iter().map(|g| (g.x[0], g.r))),
+            (_, Some((grains, _))) => extent(grains.iter().map(|(x, r)| (x.x, *r))),
+            _ => 0.0,
+        };
+    }
+    // Named by the wall with the most.
+    let mut wall_grains = (0u64, String::new(), String::new());
+    let mut most = 0.0;
+    if let Some(ws) = &scene.walls {
+        for (name, spec) in [("bottom", &ws.bottom), ("top", &ws.top)] {
+            if let SurfaceSpec::Rough { radius } = spec.surface {
+                let n = glued_count(length, radius);
+                wall_grains.0 = wall_grains.0.saturating_add(if n < 1e18 { n as u64 } else { u64::MAX });
+                if n > most {
+                    most = n;
+                    wall_grains.1 = format!("walls.{name}.surface.rough.radius");
+                    wall_grains.2 = format!("{} m ({n:.0} grains over {} m)", radius.shown(), length.shown());
+                }
+            }
+        }
+    }
+    let mut estimate = MemoryEstimate { grains: (count, count_field, count_value), wall_grains, materials: mats.len() as u64, ..Default::default() };
+    limits.check(&estimate)?;
+
     let mut p = Particles::default();
     let push = |p: &mut Particles, x: Vec2, v: Vec2, w: f64, r: f64, mat: usize| {
         let m = shape.mass(r, mats[mat].density);
         p.push(x, v, w, r, m, shape.inertia(r, m), mat as u16);
     };
-    let boundary = match scene.domain.periodic_x {
-        Some([a, b]) => Boundary::periodic_x(a, b - a),
-        None => Boundary::open(),
-    };
-    let bottom_surface_y = scene.walls.as_ref().map(|w| {
-        let y = w.bottom.y.unwrap_or(0.0);
-        match w.bottom.surface {
-            SurfaceSpec::Flat => y,
-            SurfaceSpec::Rough { radius } => y + radius,
-        }
-    });
-    let mut length = boundary.period;
+    let mut names = GrainNames::of(scene);
+    let mut packed = false;
     match &scene.grains {
         Grains::List(list) => {
             for g in list {
                 push(&mut p, Vec2::from(g.x), Vec2::from(g.v), g.omega, g.r, g.material);
             }
         }
-        Grains::File { path, material } => {
-            for (x, r) in read_particle_file(path)? {
+        Grains::File { material, .. } => {
+            let (grains, lines) = file.expect("read above");
+            for (x, r) in grains {
                 push(&mut p, x, Vec2::zeros(), 0.0, r, *material);
+            }
+            if let GrainNames::File(_, l) = &mut names {
+                *l = lines;
             }
         }
         Grains::Pack(spec) => {
+            let (lo, hi) = spec.radius.bounds();
+            let bound = crate::limits::MAX_COORDINATE_RADII * hi;
+            let coordinate_ok = |v: f64| v.abs() <= bound;
+            let y0 = scene.grains_floor().expect("validated: y_min or walls");
+            for (field, v) in [("x", spec.x[0]), ("x", spec.x[1]), ("y_min", y0)] {
+                crate::error::check(coordinate_ok(v), "grains.pack", field, v, &format!("within {bound:e} m of the origin ({:e} largest radii)", crate::limits::MAX_COORDINATE_RADII))?;
+            }
+            let mass_ok = |r: f64| shape.mass(r, mats[spec.material].density).is_finite() && shape.mass(r, mats[spec.material].density) > 0.0;
+            crate::error::check(mass_ok(lo) && mass_ok(hi), "grains.pack", "radius", format!("[{lo}, {hi}] m"), "radii whose masses are finite and > 0 at this density")?;
             let radii = spec.radius.sample(spec.count, spec.seed);
-            let y0 = spec.y_min.or(bottom_surface_y).expect("validated");
             let area: f64 = radii.iter().map(|r| std::f64::consts::PI * r * r).sum();
             let lx = spec.x[1] - spec.x[0];
             let h = area / (spec.packing_fraction * lx);
             let r_max = radii.iter().cloned().fold(0.0, f64::max);
             // Too few grains to fill the x range one grain high at this packing fraction.
-            if h < 2.0 * r_max {
+            if !(h >= 2.0 * r_max) {
                 let need = (2.0 * r_max * spec.packing_fraction * lx / (area / spec.count as f64)).ceil();
                 let allowed = format!(">= about {need} (to fill x = [{}, {}] m at packing_fraction {} at least one grain diameter high)", spec.x[0], spec.x[1], spec.packing_fraction);
                 return Err(Error::Invalid { field: "grains.pack.count".into(), value: spec.count.to_string(), allowed });
             }
-            let centres = relaxed_packing(&radii, spec.x[0], spec.x[1], y0, y0 + h, boundary.is_periodic(), spec.seed);
+            // The region must fit under a top wall placed by the scene.
+            if let Some(ws) = &scene.walls
+                && let Some(t) = ws.top.y {
+                    let top_surface = t - ws.top.surface.radius();
+                    crate::error::check(
+                        y0 + h <= top_surface,
+                        "walls.top",
+                        "y",
+                        t,
+                        &format!(">= {} m: the packing fills y = [{y0}, {}] m (its count at its packing_fraction), below the top wall's surface", y0 + h + ws.top.surface.radius(), y0 + h),
+                    )?;
+                }
+            // Periodic over the cell when the region is the cell (the packing then wraps);
+            // a narrower region is packed between its ends.
+            let periodic = boundary.is_periodic() && spec.x[0] == boundary.x_min && spec.x[1] == boundary.x_min + boundary.period;
+            let centres = relaxed_packing(&radii, spec.x[0], spec.x[1], y0, y0 + h, periodic, spec.seed);
             // A packing's order is arbitrary: store it along a space-filling curve.
             for k in crate::pack::morton_order(&centres, spec.x[0], y0, 2.0 * r_max) {
                 push(&mut p, centres[k], Vec2::zeros(), 0.0, radii[k], spec.material);
             }
-            if length == 0.0 {
-                length = lx;
-            }
+            packed = true;
         }
     }
     p.n_free = p.len();
     if length == 0.0 {
-        let (lo, hi) = p.x.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| (a.min(x.x), b.max(x.x)));
-        length = (hi - lo).max(2.0 * p.r[0]);
+        length = 2.0 * p.r[0];
     }
     let n_free = p.n_free;
     let mean_r = p.r.iter().sum::<f64>() / n_free as f64;
@@ -238,17 +324,14 @@ pub fn build_with(scene: &Scene, threads: usize) -> Result<Built, Error> {
     let mut walls = Vec::new();
     if let Some(ws) = &scene.walls {
         let top_of_grains = (0..n_free).map(|i| p.x[i].y + p.r[i]).fold(f64::NEG_INFINITY, f64::max);
-        let x0 = boundary.is_periodic().then_some(boundary.x_min).unwrap_or_else(|| p.x.iter().map(|x| x.x).fold(f64::INFINITY, f64::min));
+        let x0 = if boundary.is_periodic() { boundary.x_min } else { p.x.iter().map(|x| x.x).fold(f64::INFINITY, f64::min) };
         for (name, spec, side) in [("bottom", &ws.bottom, 1.0), ("top", &ws.top, -1.0)] {
-            let rough_r = match spec.surface {
-                SurfaceSpec::Rough { radius } => radius,
-                SurfaceSpec::Flat => 0.0,
-            };
+            let rough_r = spec.surface.radius();
             let y = spec.y.unwrap_or(top_of_grains + rough_r);
             let surface = match spec.surface {
                 SurfaceSpec::Flat => Surface::Flat,
                 SurfaceSpec::Rough { radius } => {
-                    let count = ((length / (2.0 * radius)).floor() as usize).max(1);
+                    let count = glued_count(length, radius) as usize;
                     let start = p.len();
                     for k in 0..count {
                         let x = x0 + (k as f64 + 0.5) * length / count as f64;
@@ -274,12 +357,21 @@ pub fn build_with(scene: &Scene, threads: usize) -> Result<Built, Error> {
                 x_shift: 0.0,
                 v: Vec2::new(spec.velocity_x, 0.0),
                 mass,
+                glued_radius: rough_r,
                 material: spec.material,
                 force: Vec2::zeros(),
                 force_prev: Vec2::zeros(),
             });
         }
     }
+
+    // Where the grains sit: coordinates, masses, the periodic cell, the walls, overlaps.
+    consistency::coordinates(scene, &p, &names, &walls)?;
+    consistency::masses(&p, &names, &walls, mats)?;
+    consistency::periodic_cell(&boundary, &p)?;
+    consistency::start_overlaps(&p, &walls, &boundary, &names, if packed { MAX_PACKING_OVERLAP } else { MAX_START_OVERLAP }, scene)?;
+    let start_overlap = crate::neighbor::largest_overlap(&p.x, &p.r, n_free, &boundary, f64::INFINITY)
+        .map(|(i, j, ratio)| (ratio, format!("{} and {}", names.name(i, &p, &walls), names.name(j, &p, &walls))));
 
     // Time step from the smallest grain.
     let friction = scene.model.tangential != TangentialSpec::Frictionless;
@@ -291,7 +383,6 @@ pub fn build_with(scene: &Scene, threads: usize) -> Result<Built, Error> {
     for w in walls.iter().filter(|w: &&Wall| w.is_flat()) {
         refs.push(RefContact { r_star: r, m_star: m, pair: PairMaterial::mix(mat, &mats[w.material]), inv_tangential_mass: 1.0 / m + r * r / i });
     }
-    let _ = reduced;
     let ts = &scene.time_step;
     let time_step = match ts.rule {
         TimeStepRule::Accuracy { quantity, tolerance, impact_speed } => {
@@ -303,12 +394,38 @@ pub fn build_with(scene: &Scene, threads: usize) -> Result<Built, Error> {
         }
         _ => choose(&ts.rule, ts.characteristic_speed, ts.allow_unstable, &refs, (r, m, mat), friction)?,
     };
+    let dt = time_step.dt_s;
+    let steps = crate::run::step_count(scene.duration, dt, "duration")?;
+    // The rows the summary keeps: a wall row per sample, an impact curve point per step
+    // in contact (at most every step).
+    let samples = (scene.output.samples as f64).min(steps as f64);
+    let (rows, field, value) = if scene.analysis == Analysis::Impact {
+        (steps as f64 + samples, "duration".to_string(), format!("{} s ({steps} steps of {dt:.3e} s)", scene.duration))
+    } else {
+        (samples, "output.samples".to_string(), scene.output.samples.to_string())
+    };
+    estimate.rows = (rows as u64, field, value);
+    limits.check(&estimate)?;
+    consistency::motion(&p, &walls, &names, dt)?;
+    consistency::load(scene, &p, &walls, length, depth, dt)?;
+    consistency::impact(scene, &p, &walls, &boundary, scene.duration)?;
 
-    let skin = scene.neighbor.skin * 2.0 * p.r[..n_free].iter().cloned().fold(f64::INFINITY, f64::min);
+    let r_min = p.r[..n_free].iter().cloned().fold(f64::INFINITY, f64::min);
+    let skin = scene.neighbor.skin * 2.0 * r_min;
+    let domain = Domain::new(&p, &walls, &boundary, travel(scene, &p, &walls), MAX_STEP_MOVE * r_min);
+    let start_speed = (0..n_free).map(|k| p.v[k].norm()).chain(walls.iter().map(|w| w.v.norm())).fold(0.0, f64::max);
+    let context = Context {
+        start_overlap,
+        contact_time: time_step.contact_time_s,
+        stability_limit: time_step.stability_limit_s,
+        allow_unstable: ts.allow_unstable,
+        pressure: scene.walls.as_ref().and_then(|w| if let ControlSpec::Pressure(pa) = w.top.control { Some(pa) } else { None }),
+        start_speed,
+    };
     let options = ModelOptions { limit_force: scene.model.limit_force, lever_arm: scene.model.lever_arm };
     let all_elastic = mats.iter().all(|m| m.restitution == 1.0);
     let threads = crate::threads::Threads::new(threads)?;
-    let parts = Parts { p, boundary, walls, dt: time_step.dt_s, skin, scene, threads };
+    let parts = Parts { p, boundary, walls, dt, skin, scene, threads, domain, context };
     let engine: Box<dyn Engine> = match (scene.model.tangential, all_elastic) {
         (TangentialSpec::Frictionless, false) => parts.assemble(HertzFrictionless::new(options))?,
         (TangentialSpec::Frictionless, true) => parts.assemble(HertzFrictionlessElastic::new(options))?,
@@ -320,8 +437,32 @@ pub fn build_with(scene: &Scene, threads: usize) -> Result<Built, Error> {
     Ok(Built { engine, time_step, depth, length })
 }
 
+/// The x extent of grains given as (x, r), m.
+fn extent(grains: impl Iterator<Item = (f64, f64)>) -> f64 {
+    let (lo, hi, r0) = grains.fold((f64::INFINITY, f64::NEG_INFINITY, 0.0f64), |(a, b, r0), (x, r)| (a.min(x), b.max(x), if r0 == 0.0 { r } else { r0 }));
+    (hi - lo).max(2.0 * r0)
+}
+
+/// How far a grain may travel from its first place over the run where no wall or
+/// periodic cell bounds it, m: four times what the fastest it could go carries it. The
+/// fastest: the whole kinetic energy the scene starts with in its lightest grain, plus
+/// twice the fastest wall's speed (a grain dragged along and flung), plus gravity's
+/// pull over the run.
+fn travel(scene: &Scene, p: &Particles, walls: &[Wall]) -> f64 {
+    let n = p.n_free;
+    let energy: f64 = (0..n).map(|i| 0.5 * p.m[i] * p.v[i].norm_squared() + 0.5 * p.inertia[i] * p.omega[i] * p.omega[i]).sum();
+    let m_min = p.m[..n].iter().cloned().fold(f64::INFINITY, f64::min);
+    let v_walls = walls.iter().map(|w| w.v.norm()).fold(0.0, f64::max);
+    let t = scene.duration;
+    let g = Vec2::from(scene.gravity).norm();
+    let speed = (2.0 * energy / m_min).sqrt() + 2.0 * v_walls + g * t;
+    4.0 * speed * t
+}
+
 struct Parts<'a> {
     p: Particles,
+    domain: Domain,
+    context: Context,
     boundary: Boundary,
     walls: Vec<Wall>,
     dt: f64,
@@ -365,6 +506,8 @@ impl Parts<'_> {
             threads: self.threads.clone(),
             kick: Default::default(),
             zeroed: Default::default(),
+            domain: self.domain,
+            context: self.context,
         };
         // The force stages, shared by the step and by the set-up at t = 0.
         let threads = self.threads.clone();

@@ -5,14 +5,20 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 use grainlab::run::{RunOptions, run_scene, timing_table};
-use grainlab::scenes::{BUILTIN, builtin};
-use grainlab::{Error, Scene, build};
+use grainlab::build::build_limited;
+use grainlab::limits::Limits;
+use grainlab::scenes::BUILTIN;
+use grainlab::Error;
 
 #[derive(Parser)]
 #[command(name = "grainlab", version, about = "A 2D Hertz-Mindlin DEM engine, checked against LIGGGHTS and YADE")]
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// Memory a scene may ask for (e.g. 512M, 8G): scenes whose estimate exceeds it are
+    /// refused before anything is allocated. Default: half the machine's memory.
+    #[arg(long, global = true, value_parser = grainlab::limits::parse_bytes)]
+    memory_budget: Option<u64>,
 }
 
 #[derive(Subcommand)]
@@ -100,27 +106,16 @@ enum Command {
     Scenes { name: Option<String> },
 }
 
-/// A built-in scene by name, or a scene file.
-pub fn load_scene(arg: &str) -> Result<Scene, Error> {
-    let path = std::path::Path::new(arg);
-    if path.exists() {
-        let text = std::fs::read_to_string(path).map_err(|e| Error::io(arg, e))?;
-        return Scene::from_json(&text);
-    }
-    builtin(arg).ok_or_else(|| {
-        let names: Vec<&str> = BUILTIN.iter().map(|b| b.0).collect();
-        Error::Scene(format!("`{arg}` is neither a scene file nor a built-in scene ({})", names.join(", ")))
-    })
-}
-
 fn execute(cli: Cli) -> Result<(), Error> {
+    let limits = cli.memory_budget.map_or_else(Limits::machine, Limits::with_memory);
+    let load_scene = |arg: &str| grainlab::scenes::load(arg, &limits);
     match cli.command {
         Command::Run { scene, out, duration, quiet, threads } => {
             let scene = load_scene(&scene)?;
             if let Some(d) = duration {
                 grainlab::error::check(d.is_finite() && d > 0.0, "", "--duration", d, "> 0 s")?;
             }
-            let built = grainlab::build_with(&scene, threads)?;
+            let built = grainlab::build::build_limited(&scene, threads, &limits)?;
             eprintln!("{}", built.explain());
             let opts = RunOptions { out: out.clone(), progress: !quiet, duration };
             let summary = grainlab::run::run_built(&scene, built, &opts)?;
@@ -141,7 +136,7 @@ fn execute(cli: Cli) -> Result<(), Error> {
         }
         Command::Explain { scene } => {
             let scene = load_scene(&scene)?;
-            println!("{}", build(&scene)?.explain());
+            println!("{}", build_limited(&scene, 1, &limits)?.explain());
             Ok(())
         }
         Command::Export { code, scene, out, bench } => {

@@ -42,6 +42,9 @@
 //!
 //! Everything is SI: m, kg, s, N, Pa, J.
 
+// The checks refuse NaN by writing `!(value <= bound)`: false for NaN, so NaN fails them.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 pub mod accuracy;
 #[cfg(all(target_arch = "x86_64", target_feature = "avx2", not(all(target_feature = "avx512f", target_feature = "avx512vl", target_feature = "avx512bw"))))]
 pub mod avx2;
@@ -49,12 +52,16 @@ pub mod avx2;
 pub mod avx512;
 pub mod boundary;
 pub mod build;
+pub mod consistency;
 pub mod contact;
 pub mod dim;
+pub mod domain;
 pub mod error;
 pub mod export;
+pub mod finite;
 pub mod integrate;
 pub mod lanes;
+pub mod limits;
 pub mod material;
 pub mod neighbor;
 pub mod observe;

@@ -30,11 +30,13 @@ impl RadiusDist {
         let (lo, hi) = self.bounds();
         check(lo.is_finite() && lo > 0.0, at, "min", lo, "> 0 m")?;
         check(hi.is_finite() && hi >= lo, at, "max", hi, ">= min")?;
-        if let RadiusDist::Normal { std, .. } = self {
-            check(*std >= 0.0, at, "std", std, ">= 0 m")?;
+        if let RadiusDist::Normal { mean, std, .. } = *self {
+            check(mean.is_finite(), at, "mean", mean, "finite m")?;
+            check(std.is_finite() && std >= 0.0, at, "std", std, ">= 0 m")?;
         }
-        if let RadiusDist::Lognormal { sigma, .. } = self {
-            check(*sigma >= 0.0, at, "sigma", sigma, ">= 0")?;
+        if let RadiusDist::Lognormal { median, sigma, .. } = *self {
+            check(median.is_finite() && median > 0.0, at, "median", median, "> 0 m")?;
+            check(sigma.is_finite() && sigma >= 0.0, at, "sigma", sigma, ">= 0")?;
         }
         Ok(())
     }
@@ -203,14 +205,16 @@ struct Grid {
 impl Grid {
     fn new(x0: f64, x1: f64, y0: f64, y1: f64, periodic: bool, reach: f64, n: usize) -> Self {
         let (lx, ly) = ((x1 - x0).max(reach), (y1 - y0).max(reach));
-        let mut nx = ((lx / reach).floor() as usize).max(1);
-        let mut ny = ((ly / reach).floor() as usize).max(1);
+        // Counted in floating point, so that no region overflows an integer.
+        let count = |l: f64| if (l / reach).is_finite() { (l / reach).floor().clamp(1.0, 1e15) } else { 1e15 };
+        let (mut fx, mut fy) = (count(lx), count(ly));
         // Keep the grid modest when the grains are few and far apart.
-        let max_cells = 4 * n + 64;
-        if nx * ny > max_cells {
-            let s = ((nx * ny) as f64 / max_cells as f64).sqrt().ceil() as usize;
-            (nx, ny) = ((nx / s).max(1), (ny / s).max(1));
+        let max_cells = (4 * n + 64) as f64;
+        if fx * fy > max_cells {
+            let s = (fx * fy / max_cells).sqrt().ceil();
+            (fx, fy) = ((fx / s).floor().max(1.0), (fy / s).floor().max(1.0));
         }
+        let (mut nx, ny) = (fx as usize, fy as usize);
         // A periodic row of fewer than three cells would meet itself: one cell then.
         if periodic && nx < 3 {
             nx = 1;

@@ -60,6 +60,9 @@ impl<L: ContactLaw> Stage<L> for UpdateNeighbours {
     }
     fn run(&mut self, w: &mut World<L>) -> Result<(), Error> {
         if w.neighbours.needs_rebuild(w.p.len()) {
+            // Every grain inside the domain, none that jumped: checked here, where the
+            // rebuild passes over all grains anyway.
+            w.check_domain()?;
             let pairs = w.neighbours.build(&w.p.x, &w.p.r, w.p.n_free, &w.boundary, &w.threads);
             w.pairs.replace(pairs, &w.p.r, &w.p.m, &w.threads);
         }
@@ -812,13 +815,13 @@ impl<L: ContactLaw> Stage<L> for Watchdog {
         let (ratio, i, j) = w.max_overlap;
         if ratio > self.max_overlap {
             let what = if j > w.p.len() {
-                format!("grain {i} overlaps wall {} by {:.3} of its radius (bound {})", w.walls[usize::MAX - j].name, ratio, self.max_overlap)
+                format!("grain {i} overlaps the {} wall by {:.3} of its radius (bound {})", w.walls[usize::MAX - j].name, ratio, self.max_overlap)
             } else {
                 format!("grains {i} and {j} overlap by {:.3} of the smaller radius (bound {})", ratio, self.max_overlap)
             };
-            return Err(w.unstable(what));
+            return Err(w.unstable_at(what, Some(i)));
         }
-        if w.step % self.every == 0 {
+        if w.step.is_multiple_of(self.every) {
             // The velocities as they are at the end of the step.
             crate::integrate::settle(w);
             w.check_finite()?;

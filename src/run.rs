@@ -76,8 +76,9 @@ pub struct ShearSummary {
     pub averaged_from_s: f64,
     pub shear_stress_pa: Estimate,
     pub normal_stress_pa: Estimate,
-    /// Effective friction tau/sigma (block averages of the ratio series).
-    pub stress_ratio: Estimate,
+    /// Effective friction tau/sigma (block averages of the ratio series, over the rows
+    /// where it is defined); `null` when fewer than two rows have a normal stress.
+    pub stress_ratio: Option<Estimate>,
     /// 2D packing fraction at the end (free grains' disk area over the gap area); not
     /// known for a reference code's wall output.
     pub packing_fraction: Option<f64>,
@@ -115,6 +116,23 @@ pub fn schedule(duration: f64, dt: f64, samples: u64) -> (u64, u64) {
     (total, (total / samples.max(1)).max(1))
 }
 
+/// The steps of a run of `duration` s at `dt`, refused when dt is not finite and > 0 or
+/// the count exceeds [`crate::limits::MAX_STEPS`] (`field` names what set the duration).
+pub fn step_count(duration: f64, dt: f64, field: &str) -> Result<u64, Error> {
+    let steps = (duration / dt).ceil().max(1.0);
+    if !(dt.is_finite() && dt > 0.0) {
+        return Err(Error::Invalid { field: "time_step".into(), value: format!("dt = {dt:e} s"), allowed: "a rule that gives a finite dt > 0 s (check the materials' moduli and densities and the speeds)".into() });
+    }
+    if !(steps <= crate::limits::MAX_STEPS) {
+        return Err(Error::Invalid {
+            field: field.into(),
+            value: format!("{duration} s"),
+            allowed: format!("at most {:e} steps of dt = {dt:.3e} s (it asks for {steps:.3e}): a shorter duration or a larger time step", crate::limits::MAX_STEPS),
+        });
+    }
+    Ok(steps as u64)
+}
+
 /// Build and run a scene.
 pub fn run_scene(scene: &Scene, opts: &RunOptions) -> Result<Summary, Error> {
     let built = build(scene)?;
@@ -126,6 +144,8 @@ pub fn run_scene(scene: &Scene, opts: &RunOptions) -> Result<Summary, Error> {
 pub fn run_built(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<Summary, Error> {
     let duration = opts.duration.unwrap_or(scene.duration);
     let dt = built.time_step.dt_s;
+    // The build checked the scene's duration; an override is checked here.
+    step_count(duration, dt, if opts.duration.is_some() { "--duration" } else { "duration" })?;
     let (total, sample_every) = schedule(duration, dt, scene.output.samples);
     let frame_every = if scene.output.frames > 0 { Some((total / scene.output.frames).max(1)) } else { None };
     let energy_on = scene.output.energy;
@@ -189,12 +209,16 @@ pub fn run_built(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<S
             o.observe(e);
         }
         walls_avg.accumulate(e);
-        if k % sample_every == 0 || k == total {
-            if let Err(err) = e.health() {
+        let sample = k % sample_every == 0 || k == total;
+        let frame = frame_every.is_some_and(|every| k % every == 0);
+        // Nothing is written of a state that failed its check: outputs hold only finite
+        // numbers, and the stop is diagnosed in the summary.
+        if (sample || frame)
+            && let Err(err) = e.health() {
                 error = Some(err);
-                record_energy(e, &mut outputs)?;
                 break;
             }
+        if sample {
             record_energy(e, &mut outputs)?;
             if let Some(row) = walls_avg.row(e, built.length, built.depth) {
                 if let Some(w) = outputs.walls.as_mut() {
@@ -203,21 +227,18 @@ pub fn run_built(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<S
                 wall_rows.push(row);
             }
         }
-        if let (Some(v), Some(every)) = (outputs.vtk.as_mut(), frame_every) {
-            if k % every == 0 {
-                v.frame(e)?;
-            }
+        if let (Some(v), true) = (outputs.vtk.as_mut(), frame) {
+            v.frame(e)?;
         }
-        if k % 1000 == 0 {
-            if let Some(b) = &bar {
+        if k % 1000 == 0
+            && let Some(b) = &bar {
                 b.set_position(k);
             }
-        }
         if impact.as_ref().is_some_and(|o| o.finished()) {
-            if let Err(err) = e.health() {
-                error = Some(err);
+            match e.health() {
+                Err(err) => error = Some(err),
+                Ok(()) => record_energy(e, &mut outputs)?,
             }
-            record_energy(e, &mut outputs)?;
             break;
         }
     }
@@ -280,7 +301,10 @@ pub fn stress_estimates(rows: &[WallRow], packing_fraction: Option<f64>) -> Shea
         averaged_from_s: half[0].time_s,
         shear_stress_pa: block_average(&col(|r| r.shear_stress_pa), blocks),
         normal_stress_pa: block_average(&col(|r| r.normal_stress_pa), blocks),
-        stress_ratio: block_average(&col(|r| r.stress_ratio), blocks),
+        stress_ratio: {
+            let defined: Vec<f64> = half.iter().filter_map(|r| r.stress_ratio).collect();
+            (defined.len() >= 2).then(|| block_average(&defined, 10.min(defined.len())))
+        },
         packing_fraction,
     }
 }

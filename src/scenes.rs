@@ -140,6 +140,35 @@ pub fn shear_cell(count: usize, length: f64) -> Scene {
     s
 }
 
+/// A scene named on the command line: a built-in name, or a scene file (read up to the
+/// budget's file size, [`crate::limits::Limits::file_bytes`]). A built-in name wins over
+/// a folder of that name in the working directory; a file of that name is ambiguous and
+/// refused (write `./NAME` for the file). A grain file's relative path is taken from the
+/// scene file's folder.
+pub fn load(arg: &str, limits: &crate::limits::Limits) -> Result<Scene, crate::Error> {
+    let path = std::path::Path::new(arg);
+    if let Some(scene) = builtin(arg) {
+        if path.is_file() {
+            return Err(crate::Error::Scene(format!("`{arg}` is both a built-in scene and a file in this folder: write `./{arg}` for the file")));
+        }
+        return Ok(scene);
+    }
+    if !path.exists() {
+        let names: Vec<&str> = BUILTIN.iter().map(|b| b.0).collect();
+        return Err(crate::Error::Scene(format!("`{arg}` is neither a scene file nor a built-in scene ({})", names.join(", "))));
+    }
+    let text = crate::limits::read_bounded(path, limits.file_bytes(), "scene file")?;
+    let mut scene = Scene::from_json(&text)?;
+    if let Grains::File { path: grains, .. } = &mut scene.grains {
+        let p = std::path::Path::new(grains.as_str());
+        if p.is_relative() {
+            let folder = path.parent().unwrap_or(std::path::Path::new(""));
+            *grains = folder.join(p).to_string_lossy().into_owned();
+        }
+    }
+    Ok(scene)
+}
+
 /// A built-in scene by name.
 pub fn builtin(name: &str) -> Option<Scene> {
     match name {

@@ -46,6 +46,10 @@ pub struct World<L: ContactLaw> {
     pub threads: crate::threads::Threads,
     /// The half-kick factors of the integrator.
     pub kick: crate::integrate::KickFactors,
+    /// The region the grains must stay in ([`crate::domain`]).
+    pub domain: crate::domain::Domain,
+    /// What the build knew that helps diagnose a failed run.
+    pub context: crate::domain::Context,
     /// How many of the first grains have zero forces (and torques) already this step:
     /// the drift sets the free grains' to zero once it has used them, and
     /// [`crate::pipeline::ClearForces`] clears the rest (then sets these back to 0).
@@ -71,6 +75,9 @@ impl<L: ContactLaw> World<L> {
         self.check_finite()?;
         if self.energy {
             let row = self.energy_row();
+            if let Some(term) = crate::finite::non_finite_column(&row) {
+                return Err(self.unstable(format!("the energy balance's {term} is no longer finite")));
+            }
             let scale = row.put_in();
             if scale > 0.0 && row.residual_j.abs() > MAX_RESIDUAL * scale {
                 let fastest = (0..p.n_free).max_by(|&a, &b| p.v[a].norm_squared().total_cmp(&p.v[b].norm_squared())).unwrap_or(0);
@@ -86,24 +93,59 @@ impl<L: ContactLaw> World<L> {
         Ok(())
     }
 
-    /// An error naming the first free grain whose position, velocity or spin is not finite.
+    /// An error naming the first free grain whose position, velocity, spin or force is not
+    /// finite (or whose kinetic energy overflows), or a wall whose state is not.
     pub fn check_finite(&self) -> Result<(), Error> {
         let p = &self.p;
-        match (0..p.n_free).find(|&i| !(p.x[i].x.is_finite() && p.x[i].y.is_finite() && p.v[i].norm_squared().is_finite() && p.omega[i].is_finite())) {
-            Some(i) => Err(self.unstable(format!("grain {i} has a non-finite position or velocity"))),
-            None => Ok(()),
+        let bad = |i: usize| !(p.x[i].x.is_finite() && p.x[i].y.is_finite() && p.v[i].norm_squared().is_finite() && p.omega[i].is_finite() && (p.omega[i] * p.omega[i]).is_finite());
+        if let Some(i) = (0..p.n_free).find(|&i| bad(i)) {
+            return Err(self.unstable_at(format!("grain {i} has a non-finite position, velocity or spin (x = {:?}, v = {:?}, omega = {})", p.x[i], p.v[i], p.omega[i]), Some(i)));
         }
+        if let Some(w) = self.walls.iter().find(|w| !(w.y.is_finite() && w.v.norm_squared().is_finite() && w.force.norm_squared().is_finite())) {
+            return Err(self.unstable_at(format!("the {} wall's position, velocity or force is not finite", w.name), None));
+        }
+        Ok(())
+    }
+
+    /// The domain's check at a neighbour-list rebuild ([`crate::domain::Domain::check`]).
+    pub fn check_domain(&self) -> Result<(), Error> {
+        use crate::domain::Fault;
+        let fault = self.domain.check(&self.p, &self.walls, self.neighbours.at_build(), &self.boundary, 0.5 * self.neighbours.skin);
+        let Some(fault) = fault else { return Ok(()) };
+        let p = &self.p;
+        let who = |i: usize| if i < p.n_free { format!("grain {i}") } else { format!("grain {i} (glued to a rough wall)") };
+        Err(match fault {
+            Fault::Left { grain, at } => self.unstable_at(
+                format!("{} left the domain: it is at ({:.6e}, {:.6e}) m, moving at {:.3e} m/s", who(grain), at.x, at.y, p.v[grain].norm()),
+                Some(grain),
+            ),
+            Fault::Jumped { grain, moved } => self.unstable_at(
+                format!(
+                    "{} moved {moved:.3e} m in one step ({:.3} of the smallest radius, more than {}); it moves at {:.3e} m/s",
+                    who(grain),
+                    moved / self.p.r[..p.n_free].iter().cloned().fold(f64::INFINITY, f64::min),
+                    crate::consistency::MAX_STEP_MOVE,
+                    p.v[grain].norm()
+                ),
+                Some(grain),
+            ),
+            Fault::WallsCrossed { gap } => self.unstable_at(format!("the top wall's contact surface came down to the bottom wall's (gap {gap:.3e} m)"), None),
+            Fault::WallEscaped { y } => self.unstable_at(format!("the top wall rose to y = {y:.6e} m, ten gaps above where it started"), None),
+        })
     }
 
     pub(crate) fn unstable(&self, what: String) -> Error {
+        self.unstable_at(what, None)
+    }
+
+    /// A diagnosed stop: what went wrong (with grain `grain` to blame, if one is) and the
+    /// likely cause ([`crate::domain::Context::likely_cause`]).
+    pub(crate) fn unstable_at(&self, what: String, grain: Option<usize>) -> Error {
         Error::Unstable {
             step: self.step,
             time: self.time(),
             what,
-            advice: format!(
-                "reduce the time step (now {:.3e} s; try time_step.steps_per_contact with more steps), or check the scene for grains created overlapping",
-                self.dt
-            ),
+            advice: self.context.likely_cause(&self.p, &self.walls, self.gravity, self.dt, self.time(), grain, self.domain.max_step),
         }
     }
 }

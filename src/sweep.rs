@@ -66,7 +66,8 @@ pub enum Step {
     Rayleigh(f64),
 }
 
-/// One run of the sweep. Errors are NaN where they do not apply.
+/// One run of the sweep. A quantity that does not apply (an impact's in a shear run, an
+/// error against a closed form the scene has none of) is empty.
 #[derive(Clone, Debug, Serialize)]
 pub struct SweepRow {
     pub variant: String,
@@ -76,28 +77,34 @@ pub struct SweepRow {
     pub steps: u64,
     pub wall_time_s: f64,
     pub ns_per_particle_step: f64,
-    pub energy_residual_rel: f64,
+    pub energy_residual_rel: Option<f64>,
     // Impacts.
-    pub restitution: f64,
-    pub restitution_err_converged: f64,
-    pub restitution_err_input: f64,
-    pub peak_force_n: f64,
-    pub peak_force_err_converged_rel: f64,
-    pub peak_force_err_hertz_rel: f64,
-    pub max_overlap_m: f64,
-    pub max_overlap_err_converged_rel: f64,
-    pub max_overlap_err_hertz_rel: f64,
-    pub contact_time_s: f64,
-    pub contact_time_err_converged_rel: f64,
-    pub contact_time_err_hertz_rel: f64,
+    pub restitution: Option<f64>,
+    pub restitution_err_converged: Option<f64>,
+    pub restitution_err_input: Option<f64>,
+    pub peak_force_n: Option<f64>,
+    pub peak_force_err_converged_rel: Option<f64>,
+    pub peak_force_err_hertz_rel: Option<f64>,
+    pub max_overlap_m: Option<f64>,
+    pub max_overlap_err_converged_rel: Option<f64>,
+    pub max_overlap_err_hertz_rel: Option<f64>,
+    pub contact_time_s: Option<f64>,
+    pub contact_time_err_converged_rel: Option<f64>,
+    pub contact_time_err_hertz_rel: Option<f64>,
     // Shear.
-    pub stress_ratio: f64,
-    pub stress_ratio_ci95: f64,
-    pub stress_ratio_err_converged: f64,
+    pub stress_ratio: Option<f64>,
+    pub stress_ratio_ci95: Option<f64>,
+    pub stress_ratio_err_converged: Option<f64>,
 }
 
-fn rel(a: f64, b: f64) -> f64 {
-    (a - b).abs() / b.abs()
+/// |a - b| / |b| where both are known.
+fn rel(a: Option<f64>, b: Option<f64>) -> Option<f64> {
+    Some((a? - b?).abs() / b?.abs()).filter(|e| e.is_finite())
+}
+
+/// |a - b| where both are known.
+fn abs_diff(a: Option<f64>, b: Option<f64>) -> Option<f64> {
+    Some((a? - b?).abs())
 }
 
 /// Run `scene` at every step setting for every variant.
@@ -123,9 +130,8 @@ pub fn sweep(scene: &Scene, steps: &[Step], variants: &[Variant], duration: Opti
             let t0 = Instant::now();
             let sum = run_scene(&s, &RunOptions { duration, ..RunOptions::default() })?;
             let wall = t0.elapsed().as_secs_f64();
-            let nan = f64::NAN;
             let imp = sum.impact;
-            let sh = sum.shear.as_ref();
+            let ratio = sum.shear.as_ref().and_then(|s| s.stress_ratio);
             let row = SweepRow {
                 variant: v.label(),
                 rule: match *st {
@@ -137,22 +143,22 @@ pub fn sweep(scene: &Scene, steps: &[Step], variants: &[Variant], duration: Opti
                 steps: sum.steps,
                 wall_time_s: wall,
                 ns_per_particle_step: 1e9 * wall / (sum.steps.max(1) as f64 * sum.grains.max(1) as f64),
-                energy_residual_rel: sum.energy.as_ref().map_or(nan, |e| e.max_residual_rel),
-                restitution: imp.map_or(nan, |i| i.restitution_normal),
-                restitution_err_converged: nan,
-                restitution_err_input: nan,
-                peak_force_n: imp.map_or(nan, |i| i.peak_force_n),
-                peak_force_err_converged_rel: nan,
-                peak_force_err_hertz_rel: nan,
-                max_overlap_m: imp.map_or(nan, |i| i.max_overlap_m),
-                max_overlap_err_converged_rel: nan,
-                max_overlap_err_hertz_rel: nan,
-                contact_time_s: imp.map_or(nan, |i| i.contact_time_s),
-                contact_time_err_converged_rel: nan,
-                contact_time_err_hertz_rel: nan,
-                stress_ratio: sh.map_or(nan, |s| s.stress_ratio.mean),
-                stress_ratio_ci95: sh.map_or(nan, |s| s.stress_ratio.ci95),
-                stress_ratio_err_converged: nan,
+                energy_residual_rel: sum.energy.as_ref().map(|e| e.max_residual_rel),
+                restitution: imp.map(|i| i.restitution_normal),
+                restitution_err_converged: None,
+                restitution_err_input: None,
+                peak_force_n: imp.map(|i| i.peak_force_n),
+                peak_force_err_converged_rel: None,
+                peak_force_err_hertz_rel: None,
+                max_overlap_m: imp.map(|i| i.max_overlap_m),
+                max_overlap_err_converged_rel: None,
+                max_overlap_err_hertz_rel: None,
+                contact_time_s: imp.map(|i| i.contact_time_s),
+                contact_time_err_converged_rel: None,
+                contact_time_err_hertz_rel: None,
+                stress_ratio: ratio.map(|r| r.mean),
+                stress_ratio_ci95: ratio.map(|r| r.ci95).filter(|c| c.is_finite()),
+                stress_ratio_err_converged: None,
             };
             runs.push((row, sum));
         }
@@ -162,21 +168,21 @@ pub fn sweep(scene: &Scene, steps: &[Step], variants: &[Variant], duration: Opti
         let closed = closed_form(scene);
         for (mut row, _) in runs {
             if scene.analysis == Analysis::Impact {
-                row.restitution_err_converged = (row.restitution - conv.restitution).abs();
+                row.restitution_err_converged = abs_diff(row.restitution, conv.restitution);
                 row.peak_force_err_converged_rel = rel(row.peak_force_n, conv.peak_force_n);
                 row.max_overlap_err_converged_rel = rel(row.max_overlap_m, conv.max_overlap_m);
                 row.contact_time_err_converged_rel = rel(row.contact_time_s, conv.contact_time_s);
                 if let Some(c) = closed {
-                    row.restitution_err_input = (row.restitution - c.restitution).abs();
+                    row.restitution_err_input = abs_diff(row.restitution, Some(c.restitution));
                     if c.restitution == 1.0 {
-                        row.max_overlap_err_hertz_rel = rel(row.max_overlap_m, c.max_overlap);
-                        row.peak_force_err_hertz_rel = rel(row.peak_force_n, c.peak_force);
-                        row.contact_time_err_hertz_rel = rel(row.contact_time_s, c.contact_time);
+                        row.max_overlap_err_hertz_rel = rel(row.max_overlap_m, Some(c.max_overlap));
+                        row.peak_force_err_hertz_rel = rel(row.peak_force_n, Some(c.peak_force));
+                        row.contact_time_err_hertz_rel = rel(row.contact_time_s, Some(c.contact_time));
                     }
                 }
             }
             if scene.analysis == Analysis::Shear {
-                row.stress_ratio_err_converged = (row.stress_ratio - conv.stress_ratio).abs();
+                row.stress_ratio_err_converged = abs_diff(row.stress_ratio, conv.stress_ratio);
             }
             progress(&row);
             out.push(row);

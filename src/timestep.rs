@@ -76,6 +76,16 @@ pub fn choose(
     });
     let (tc, limit) = limits(refs, v, friction);
     let rayleigh = rayleigh_time(smallest.0, smallest.2);
+    // Moduli, densities or speeds at the edge of the floating-point range give a contact
+    // time or limit of 0 or infinity, from which no time step follows.
+    let positive = |t: f64| t.is_finite() && t > 0.0;
+    if !(positive(tc) && positive(limit) && positive(rayleigh)) {
+        return Err(Error::Invalid {
+            field: "time_step".into(),
+            value: format!("t_c = {tc:e} s, stability limit {limit:e} s, Rayleigh time {rayleigh:e} s of the smallest grain at {v} m/s"),
+            allowed: "materials (moduli, densities), radii and speeds whose contact time scales are finite and > 0".into(),
+        });
+    }
     let dt = match *rule {
         TimeStepRule::Fixed { dt } => dt,
         TimeStepRule::StepsPerContact { steps, impact_speed } => limits(refs, impact_speed, friction).0 / steps,

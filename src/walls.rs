@@ -44,6 +44,9 @@ pub struct Wall {
     pub v: Vec2,
     /// Mass that the load accelerates, kg.
     pub mass: f64,
+    /// Radius of a rough wall's glued grains (its contact surface lies this far from `y`
+    /// towards the grains), 0 for a flat wall, m.
+    pub glued_radius: f64,
     /// Material index of the wall's surface (a flat wall's contacts mix it with the
     /// grain's; a rough wall's glued grains carry it themselves).
     pub material: usize,

@@ -352,16 +352,19 @@ pub fn compare_impact(case: &str, code: Code, engine: &ImpactSummary, reference:
 /// Compare shear estimates: the difference of the means must lie inside the combined 95%
 /// interval `sqrt(ci_a^2 + ci_b^2)` (a Welch-type bound on two independent estimates).
 pub fn compare_shear(case: &str, code: Code, engine: &ShearSummary, reference: &ShearSummary) -> Vec<Row> {
+    // tau/sigma is undefined without a normal stress: then it cannot agree.
+    let undefined = crate::stats::Estimate { mean: f64::NAN, ci95: f64::NAN, blocks: 0 };
+    let (ratio_a, ratio_b) = (engine.stress_ratio.unwrap_or(undefined), reference.stress_ratio.unwrap_or(undefined));
     let pairs = [
         ("shear_stress_pa", engine.shear_stress_pa, reference.shear_stress_pa),
         ("normal_stress_pa", engine.normal_stress_pa, reference.normal_stress_pa),
-        ("stress_ratio", engine.stress_ratio, reference.stress_ratio),
+        ("stress_ratio", ratio_a, ratio_b),
     ];
     let mut rows: Vec<Row> = pairs.iter().map(|(q, a, b)| Row::new(case, code, q, a.mean, b.mean, (a.ci95 * a.ci95 + b.ci95 * b.ci95).sqrt(), false)).collect();
     // Welch's t test on tau/sigma: the two block-average estimates have equal means unless
     // p < 0.05. The row carries p as its "difference" from 1 so that the same pass rule
     // (difference <= bound) reads p >= 0.05.
-    let p = welch_p(&engine.stress_ratio, &reference.stress_ratio);
+    let p = welch_p(&ratio_a, &ratio_b);
     let mut r = Row::new(case, code, "stress_ratio_welch_p_value", p, 1.0, 0.95, false);
     r.pass = p >= 0.05;
     rows.push(r);

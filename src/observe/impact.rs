@@ -25,8 +25,9 @@ pub struct ImpactSummary {
     pub impact_speed_m_s: f64,
     /// Realised normal restitution, -vn_after / vn_before.
     pub restitution_normal: f64,
-    /// Tangential restitution of the contact points, -vt_after / vt_before (NaN if head-on).
-    pub restitution_tangential: f64,
+    /// Tangential restitution of the contact points, -vt_after / vt_before; undefined
+    /// (empty, `null`) for a head-on impact.
+    pub restitution_tangential: Option<f64>,
     /// Tangential velocity of grain 0's centre after the impact, m/s.
     pub rebound_tangential_velocity_m_s: f64,
     /// Normal velocity of grain 0's centre after the impact, m/s.
@@ -195,7 +196,7 @@ impl ImpactObserver {
         Some(ImpactSummary {
             impact_speed_m_s: -before.vn,
             restitution_normal: -after.vn / before.vn,
-            restitution_tangential: if before.vt.abs() > 1e-12 * before.vn.abs() { -after.vt / before.vt } else { f64::NAN },
+            restitution_tangential: (before.vt.abs() > 1e-12 * before.vn.abs()).then(|| -after.vt / before.vt),
             rebound_tangential_velocity_m_s: v0.dot(&t),
             rebound_normal_velocity_m_s: v0.dot(&n),
             rebound_spin_rad_s: w0,

@@ -5,6 +5,8 @@
 //! the mean grain diameter for spheres in the plane; `walls.thickness` overrides).
 //! Shear stress tau = (F_bottom,x - F_top,x) / (2 L_x t), normal stress
 //! sigma = (F_top,y - F_bottom,y) / (2 L_x t), both positive in a sheared, compressed cell.
+//! Their ratio is undefined (written as an empty cell, `null` in JSON) while sigma is zero,
+//! e.g. before any grain touches a wall.
 
 use serde::Serialize;
 
@@ -22,7 +24,8 @@ pub struct WallRow {
     pub gap_m: f64,
     pub shear_stress_pa: f64,
     pub normal_stress_pa: f64,
-    pub stress_ratio: f64,
+    /// tau/sigma; undefined (an empty cell) while the normal stress is zero.
+    pub stress_ratio: Option<f64>,
 }
 
 /// Averages the wall forces over every step of a sample interval.
@@ -53,6 +56,12 @@ impl WallAverager {
     }
 }
 
+/// tau/sigma where it is defined: sigma non-zero and the quotient finite.
+pub fn ratio(tau: f64, sigma: f64) -> Option<f64> {
+    let r = tau / sigma;
+    (sigma != 0.0 && r.is_finite()).then_some(r)
+}
+
 impl WallRow {
     /// A row from the forces of the grains on the bottom (`b`) and top (`t`) walls, N,
     /// the gap, m, the cell length and depth, m.
@@ -69,7 +78,7 @@ impl WallRow {
             gap_m,
             shear_stress_pa: tau,
             normal_stress_pa: sigma,
-            stress_ratio: tau / sigma,
+            stress_ratio: ratio(tau, sigma),
         }
     }
 }

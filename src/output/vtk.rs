@@ -32,6 +32,12 @@ impl VtkSeries {
     pub fn frame(&mut self, e: &dyn Engine) -> Result<(), Error> {
         let p = e.particles();
         let n = p.len();
+        // The last line of defence (the run checks the state before a frame): no frame
+        // holds a number that is not finite.
+        let finite = |v: &crate::dim::Vec2| v.x.is_finite() && v.y.is_finite();
+        if let Some(i) = (0..n).find(|&i| !(finite(&p.x[i]) && finite(&p.v[i]) && finite(&p.f[i]) && p.omega[i].is_finite())) {
+            return Err(Error::Other(format!("frame at t = {:e} s not written: grain {i}'s state is not finite", e.time())));
+        }
         let mut s = String::with_capacity(200 * n + 1000);
         s.push_str("<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"0.1\" byte_order=\"LittleEndian\">\n  <PolyData>\n");
         let _ = writeln!(s, "    <Piece NumberOfPoints=\"{n}\" NumberOfVerts=\"{n}\" NumberOfLines=\"0\" NumberOfStrips=\"0\" NumberOfPolys=\"0\">");
