@@ -1,7 +1,9 @@
 //! The command line: `grainlab run|explain|scenes|...` (`grainlab --help` lists them all).
 
+use std::io::Write as _;
 use std::path::PathBuf;
 use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use clap::{Parser, Subcommand};
 use grainlab::run::{RunOptions, run_scene, timing_table};
@@ -9,7 +11,7 @@ use grainlab::scenes::{BUILTIN, builtin};
 use grainlab::{Error, Scene, build};
 
 #[derive(Parser)]
-#[command(name = "grainlab", version, about = "A 2D Hertz-Mindlin DEM engine, checked against LIGGGHTS and YADE")]
+#[command(name = "grainlab", version, about = "A 2D Hertz-Mindlin DEM engine, checked against LIGGGHTS and YADE", after_help = EXIT_CODES)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -113,53 +115,92 @@ pub fn load_scene(arg: &str) -> Result<Scene, Error> {
     })
 }
 
+/// The exit codes, for `grainlab --help` (README, "Exit codes"; `grainlab::error::exit`).
+const EXIT_CODES: &str = "Exit codes:
+  0    success
+  1    other failure (e.g. compare with comparisons outside their bound)
+  2    bad input: a scene, an option value, or an output folder grainlab may not use
+  3    I/O failure (a summary that could not be written is on stdout)
+  4    run stopped unstable, with a diagnosis
+  130  interrupted by SIGINT or SIGTERM, everything written";
+
+/// Set when stdout's reader has gone (`grainlab scenes shear | head -3`).
+static STDOUT_CLOSED: AtomicBool = AtomicBool::new(false);
+
+/// Write to stdout. A closed pipe is not an error: what follows is dropped and the
+/// command finishes its work and exits with its own code (0 for a listing), quietly. Any
+/// other failure (a full disk behind `> file`) is an I/O error.
+fn to_stdout(text: std::fmt::Arguments) -> Result<(), Error> {
+    if STDOUT_CLOSED.load(Ordering::Relaxed) {
+        return Ok(());
+    }
+    let mut out = std::io::stdout().lock();
+    match out.write_fmt(text).and_then(|()| out.flush()) {
+        Ok(()) => Ok(()),
+        Err(e) => {
+            STDOUT_CLOSED.store(true, Ordering::Relaxed);
+            if e.kind() == std::io::ErrorKind::BrokenPipe { Ok(()) } else { Err(Error::io("stdout", e)) }
+        }
+    }
+}
+
+/// `println!` through [`to_stdout`]: `say!(...)?`.
+macro_rules! say {
+    ($($arg:tt)*) => { to_stdout(format_args!("{}\n", format_args!($($arg)*))) };
+}
+
+/// `eprintln!` that does not panic when stderr is closed: a message nobody can read is
+/// dropped.
+macro_rules! note {
+    ($($arg:tt)*) => {{
+        let _ = writeln!(std::io::stderr().lock(), $($arg)*);
+    }};
+}
+
 fn execute(cli: Cli) -> Result<(), Error> {
     match cli.command {
         Command::Run { scene, out, duration, quiet, threads } => {
             let scene = load_scene(&scene)?;
             if let Some(d) = duration {
-                grainlab::error::check(d.is_finite() && d > 0.0, "", "--duration", d, "> 0 s")?;
+                grainlab::error::check_option(d.is_finite() && d > 0.0, "--duration", d, "> 0 s")?;
             }
             let built = grainlab::build_with(&scene, threads)?;
-            eprintln!("{}", built.explain());
+            note!("{}", built.explain());
             let opts = RunOptions { out: out.clone(), progress: !quiet, duration };
             let summary = grainlab::run::run_built(&scene, built, &opts)?;
-            eprint!("{}", timing_table(&summary));
+            note!("{}", timing_table(&summary).trim_end());
             if let Some(w) = summary.energy.as_ref().and_then(|e| e.warning.as_ref()) {
-                eprintln!("warning: {w}");
+                note!("warning: {w}");
             }
-            println!("{}", serde_json::to_string_pretty(&summary).expect("serialisable"));
+            say!("{}", serde_json::to_string_pretty(&summary).expect("serialisable"))?;
             if let Some(dir) = out {
-                eprintln!("wrote {}", dir.display());
+                note!("wrote {}", dir.display());
             }
             let _ = run_scene;
             Ok(())
         }
         Command::Handover { threads, samples } => {
-            println!("{}", serde_json::to_string_pretty(&grainlab::threads::hand_over_summary(threads, samples)?).expect("numbers serialise"));
-            Ok(())
+            say!("{}", serde_json::to_string_pretty(&grainlab::threads::hand_over_summary(threads, samples)?).expect("numbers serialise"))
         }
         Command::Explain { scene } => {
             let scene = load_scene(&scene)?;
-            println!("{}", build(&scene)?.explain());
-            Ok(())
+            say!("{}", build(&scene)?.explain())
         }
         Command::Export { code, scene, out, bench } => {
             let scene = load_scene(&scene)?;
             for path in grainlab::export::export_with(&scene, code, &out, bench)? {
-                println!("{}", path.display());
+                say!("{}", path.display())?;
             }
             Ok(())
         }
         Command::Cases { root, filter } => {
             let n = grainlab::workbench::write_cases(&root, filter.as_deref())?;
-            eprintln!("wrote {n} cases under {}", root.display());
+            note!("wrote {n} cases under {}", root.display());
             Ok(())
         }
         Command::Digest { case_dir, code, run_dir } => {
             let out = grainlab::workbench::digest(&case_dir, code, &run_dir)?;
-            println!("{}", out.display());
-            Ok(())
+            say!("{}", out.display())
         }
         Command::Compare { root, filter, csv } => compare(&root, filter.as_deref(), csv.as_deref()),
         Command::Sweep { scene, steps, rayleigh, variants, duration, out } => {
@@ -172,40 +213,41 @@ fn execute(cli: Cli) -> Result<(), Error> {
                     Step::PerContact(n) => (n.is_finite() && n >= 1.0, n),
                     Step::Rayleigh(f) => (f > 0.0 && f <= 1.0, f),
                 };
-                grainlab::error::check(ok, "", if matches!(s, Step::PerContact(_)) { "--steps" } else { "--rayleigh" }, v, ">= 1 steps per contact, or a Rayleigh fraction in (0, 1]")?;
+                grainlab::error::check_option(ok, if matches!(s, Step::PerContact(_)) { "--steps" } else { "--rayleigh" }, v, ">= 1 steps per contact, or a Rayleigh fraction in (0, 1]")?;
             }
             let mut vars = vec![Variant::Scene];
             for f in &variants {
                 vars.extend(Variant::family(f)?);
             }
-            let rows = sweep(&scene, &st, &vars, duration, |r| eprintln!("{:<28} {:<16} dt = {:.3e} s  {:.1} ns/particle-step", r.variant, r.rule, r.dt_s, r.ns_per_particle_step))?;
+            let rows = sweep(&scene, &st, &vars, duration, |r| note!("{:<28} {:<16} dt = {:.3e} s  {:.1} ns/particle-step", r.variant, r.rule, r.dt_s, r.ns_per_particle_step))?;
             match out {
                 Some(path) => {
                     let mut w = grainlab::output::csv::CsvSeries::create(&path)?;
                     for r in &rows {
                         w.row(r)?;
                     }
-                    eprintln!("wrote {}", path.display());
+                    note!("wrote {}", path.display());
                 }
                 None => {
-                    let mut w = csv::Writer::from_writer(std::io::stdout());
+                    let mut w = csv::Writer::from_writer(Vec::new());
                     for r in &rows {
                         w.serialize(r).map_err(|e| Error::Other(e.to_string()))?;
                     }
+                    let text = w.into_inner().map_err(|e| Error::Other(e.to_string()))?;
+                    to_stdout(format_args!("{}", String::from_utf8_lossy(&text)))?;
                 }
             }
             Ok(())
         }
         Command::Scenes { name: None } => {
             for (n, d) in BUILTIN {
-                println!("{n:<10} {d}");
+                say!("{n:<10} {d}")?;
             }
             Ok(())
         }
         Command::Scenes { name: Some(n) } => {
             let s = load_scene(&n)?;
-            println!("{}", s.to_json());
-            Ok(())
+            say!("{}", s.to_json())
         }
     }
 }
@@ -219,10 +261,10 @@ fn compare(root: &std::path::Path, filter: Option<&str>, csv: Option<&std::path:
         }
         rows.extend(compare_case(&dir)?);
     }
-    println!("{:<40} {:<9} {:<32} {:>14} {:>14} {:>10} {:>9} pass", "case", "code", "quantity", "engine", "reference", "diff", "bound");
+    say!("{:<40} {:<9} {:<32} {:>14} {:>14} {:>10} {:>9} pass", "case", "code", "quantity", "engine", "reference", "diff", "bound")?;
     for r in &rows {
         let (d, kind) = if r.relative { (r.rel_diff, "rel") } else { (r.abs_diff, "abs") };
-        println!(
+        say!(
             "{:<40} {:<9} {:<32} {:>14.7e} {:>14.7e} {:>10.2e} {:>5.0e} {kind} {}",
             r.case,
             r.code.name(),
@@ -232,10 +274,10 @@ fn compare(root: &std::path::Path, filter: Option<&str>, csv: Option<&std::path:
             d,
             r.tolerance,
             if r.pass { "yes" } else { "NO" }
-        );
+        )?;
     }
     let failed = rows.iter().filter(|r| !r.pass).count();
-    eprintln!("{} comparisons, {} outside their bound", rows.len(), failed);
+    note!("{} comparisons, {} outside their bound", rows.len(), failed);
     if let Some(path) = csv {
         let mut w = grainlab::output::csv::CsvSeries::create(path)?;
         for r in &rows {
@@ -252,8 +294,8 @@ pub fn main() -> ExitCode {
     match execute(Cli::parse()) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e}");
-            ExitCode::FAILURE
+            note!("error: {e}");
+            ExitCode::from(e.exit_code())
         }
     }
 }
