@@ -6,6 +6,7 @@ use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use clap::{Parser, Subcommand};
+use grainlab::output::{csv::CsvSeries, folder::OutFolder};
 use grainlab::run::{RunOptions, run_scene, timing_table};
 use grainlab::scenes::{BUILTIN, builtin};
 use grainlab::{Error, Scene, build};
@@ -22,9 +23,15 @@ enum Command {
     /// Run a scene (a built-in name or a JSON file).
     Run {
         scene: String,
-        /// Output directory for summary.json, CSV series and ParaView frames.
+        /// Output folder for summary.json, CSV series and ParaView frames: a new or
+        /// empty folder, or one grainlab wrote (see --overwrite); its manifest.json lists
+        /// what grainlab wrote.
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Delete the files an earlier grainlab command wrote in --out (those its
+        /// manifest.json lists) before the run. A folder holding anything else is refused.
+        #[arg(long)]
+        overwrite: bool,
         /// Override the scene's duration, s.
         #[arg(long)]
         duration: Option<f64>,
@@ -51,8 +58,12 @@ enum Command {
     Export {
         code: grainlab::export::Code,
         scene: String,
+        /// Output folder: new, empty, or one grainlab wrote (see --overwrite).
         #[arg(long)]
         out: PathBuf,
+        /// Delete the files an earlier grainlab command wrote in --out first.
+        #[arg(long)]
+        overwrite: bool,
         /// A timing deck: record nothing, print the loop time (scripts/bench-peers).
         #[arg(long)]
         bench: bool,
@@ -159,14 +170,18 @@ macro_rules! note {
 
 fn execute(cli: Cli) -> Result<(), Error> {
     match cli.command {
-        Command::Run { scene, out, duration, quiet, threads } => {
+        Command::Run { scene, out, overwrite, duration, quiet, threads } => {
             let scene = load_scene(&scene)?;
             if let Some(d) = duration {
                 grainlab::error::check_option(d.is_finite() && d > 0.0, "--duration", d, "> 0 s")?;
             }
+            if let Some(dir) = &out {
+                // Refused before a long build; the run claims the folder when it starts.
+                OutFolder::check(dir, overwrite)?;
+            }
             let built = grainlab::build_with(&scene, threads)?;
             note!("{}", built.explain());
-            let opts = RunOptions { out: out.clone(), progress: !quiet, duration };
+            let opts = RunOptions { out: out.clone(), overwrite, progress: !quiet, duration };
             let summary = grainlab::run::run_built(&scene, built, &opts)?;
             note!("{}", timing_table(&summary).trim_end());
             if let Some(w) = summary.energy.as_ref().and_then(|e| e.warning.as_ref()) {
@@ -186,12 +201,15 @@ fn execute(cli: Cli) -> Result<(), Error> {
             let scene = load_scene(&scene)?;
             say!("{}", build(&scene)?.explain())
         }
-        Command::Export { code, scene, out, bench } => {
+        Command::Export { code, scene, out, overwrite, bench } => {
             let scene = load_scene(&scene)?;
-            for path in grainlab::export::export_with(&scene, code, &out, bench)? {
-                say!("{}", path.display())?;
+            let files = grainlab::export::export_files(&scene, code, bench)?;
+            let mut folder = OutFolder::claim(&out, overwrite, &format!("export {} {}", code.name(), scene.name))?;
+            for (name, text) in files {
+                folder.write(name, text.as_bytes())?;
+                say!("{}", out.join(name).display())?;
             }
-            Ok(())
+            folder.finish("completed")
         }
         Command::Cases { root, filter } => {
             let n = grainlab::workbench::write_cases(&root, filter.as_deref())?;
@@ -222,10 +240,11 @@ fn execute(cli: Cli) -> Result<(), Error> {
             let rows = sweep(&scene, &st, &vars, duration, |r| note!("{:<28} {:<16} dt = {:.3e} s  {:.1} ns/particle-step", r.variant, r.rule, r.dt_s, r.ns_per_particle_step))?;
             match out {
                 Some(path) => {
-                    let mut w = grainlab::output::csv::CsvSeries::create(&path)?;
+                    let mut w = CsvSeries::staged(&path)?;
                     for r in &rows {
                         w.row(r)?;
                     }
+                    w.finish()?;
                     note!("wrote {}", path.display());
                 }
                 None => {
@@ -279,10 +298,11 @@ fn compare(root: &std::path::Path, filter: Option<&str>, csv: Option<&std::path:
     let failed = rows.iter().filter(|r| !r.pass).count();
     note!("{} comparisons, {} outside their bound", rows.len(), failed);
     if let Some(path) = csv {
-        let mut w = grainlab::output::csv::CsvSeries::create(path)?;
+        let mut w = CsvSeries::staged(path)?;
         for r in &rows {
             w.row(r)?;
         }
+        w.finish()?;
     }
     if failed > 0 {
         return Err(Error::Other(format!("{failed} comparisons outside their bound")));

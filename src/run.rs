@@ -13,6 +13,7 @@ use crate::observe::energy::EnergyRow;
 use crate::observe::impact::{ImpactObserver, ImpactSummary};
 use crate::observe::stress::{WallAverager, WallRow};
 use crate::output::csv::CsvSeries;
+use crate::output::folder::OutFolder;
 use crate::output::vtk::VtkSeries;
 use crate::scene::{Analysis, Scene};
 use crate::stats::{Estimate, block_average};
@@ -20,8 +21,11 @@ use crate::timestep::TimeStepInfo;
 
 #[derive(Clone, Debug, Default)]
 pub struct RunOptions {
-    /// Output directory (created); nothing is written without one.
+    /// Output folder (created); nothing is written without one. It must be new, empty,
+    /// or hold an earlier grainlab output and `overwrite` be set ([`OutFolder`]).
     pub out: Option<PathBuf>,
+    /// Delete the files an earlier grainlab command listed in `out`'s manifest first.
+    pub overwrite: bool,
     /// Show a progress bar on stderr (when it is a terminal and the run is long).
     pub progress: bool,
     /// Override the scene's duration, s.
@@ -103,9 +107,19 @@ pub struct Summary {
 }
 
 struct Outputs {
+    folder: Option<OutFolder>,
     energy: Option<CsvSeries>,
     walls: Option<CsvSeries>,
     vtk: Option<VtkSeries>,
+}
+
+impl Outputs {
+    fn frame(&mut self, e: &dyn crate::build::Engine) -> Result<(), Error> {
+        match (self.vtk.as_mut(), self.folder.as_mut()) {
+            (Some(v), Some(f)) => v.frame(e, f),
+            _ => Ok(()),
+        }
+    }
 }
 
 /// Steps of a run of `duration` s at `dt`, and the steps per output sample: the schedule
@@ -129,18 +143,19 @@ pub fn run_built(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<S
     let (total, sample_every) = schedule(duration, dt, scene.output.samples);
     let frame_every = if scene.output.frames > 0 { Some((total / scene.output.frames).max(1)) } else { None };
     let energy_on = scene.output.energy;
-    let mut outputs = Outputs { energy: None, walls: None, vtk: None };
+    let mut outputs = Outputs { folder: None, energy: None, walls: None, vtk: None };
     if let Some(dir) = &opts.out {
-        std::fs::create_dir_all(dir).map_err(|e| Error::io(dir.display(), e))?;
+        let mut folder = OutFolder::claim(dir, opts.overwrite, &format!("run {}", scene.name))?;
         if energy_on {
-            outputs.energy = Some(CsvSeries::create(&dir.join("energy.csv"))?);
+            outputs.energy = Some(folder.series("energy.csv")?);
         }
         if !built.engine.walls().is_empty() {
-            outputs.walls = Some(CsvSeries::create(&dir.join("walls.csv"))?);
+            outputs.walls = Some(folder.series("walls.csv")?);
         }
         if frame_every.is_some() {
-            outputs.vtk = Some(VtkSeries::new(dir)?);
+            outputs.vtk = Some(VtkSeries::new(&mut folder)?);
         }
+        outputs.folder = Some(folder);
     }
     let pipeline = built.explain();
     let e = built.engine.as_mut();
@@ -164,9 +179,7 @@ pub fn run_built(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<S
         Ok(())
     };
     record_energy(e, &mut outputs)?;
-    if let (Some(v), Some(_)) = (outputs.vtk.as_mut(), frame_every) {
-        v.frame(e)?;
-    }
+    outputs.frame(e)?;
     let bar = if opts.progress {
         let b = ProgressBar::new(total);
         b.set_style(ProgressStyle::with_template("{msg} [{bar:40}] {percent}% {elapsed_precise} eta {eta}").expect("template").progress_chars("=> "));
@@ -203,10 +216,8 @@ pub fn run_built(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<S
                 wall_rows.push(row);
             }
         }
-        if let (Some(v), Some(every)) = (outputs.vtk.as_mut(), frame_every) {
-            if k % every == 0 {
-                v.frame(e)?;
-            }
+        if frame_every.is_some_and(|every| k % every == 0) {
+            outputs.frame(e)?;
         }
         if k % 1000 == 0 {
             if let Some(b) = &bar {
@@ -247,19 +258,28 @@ pub fn run_built(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<S
         shear,
         stage_timing,
     };
-    if let Some(dir) = &opts.out {
-        let path = dir.join("summary.json");
-        std::fs::write(&path, serde_json::to_string_pretty(&summary).expect("serialisable")).map_err(|e| Error::io(path.display(), e))?;
-        if let Some(o) = impact.as_ref() {
-            let mut w = CsvSeries::create(&dir.join("force_overlap.csv"))?;
-            for c in &o.curve {
-                w.row(c)?;
+    // Everything is written even when one write fails; the first failure is kept.
+    let mut write_error: Option<Error> = None;
+    if let Some(folder) = outputs.folder.as_mut() {
+        let mut keep = |r: Result<(), Error>| {
+            if let Err(e) = r {
+                write_error.get_or_insert(e);
+            }
+        };
+        for (series, name) in [(outputs.energy.take(), "energy.csv"), (outputs.walls.take(), "walls.csv")] {
+            if let Some(s) = series {
+                keep(folder.close_series(s, name));
             }
         }
+        if let Some(o) = impact.as_ref() {
+            keep(folder.write_series("force_overlap.csv", &o.curve));
+        }
+        keep(folder.write("summary.json", (serde_json::to_string_pretty(&summary).expect("serialisable") + "\n").as_bytes()));
+        keep(folder.finish(&summary.status));
     }
-    match error {
-        Some(err) => Err(err),
-        None => Ok(summary),
+    match (write_error, error) {
+        (Some(err), _) | (None, Some(err)) => Err(err),
+        (None, None) => Ok(summary),
     }
 }
 

@@ -4,7 +4,8 @@
 //! code (README, "Exit codes").
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
+use std::process::{Child, Command, Output, Stdio};
+use std::time::{Duration, Instant};
 
 use serde_json::Value;
 
@@ -41,9 +42,227 @@ fn scene_file(dir: &Path, name: &str, file: &str, change: impl Fn(&mut Value)) -
     path
 }
 
+/// Every file under `dir`, relative with `/`, sorted.
+fn files(dir: &Path) -> Vec<String> {
+    fn walk(root: &Path, d: &Path, out: &mut Vec<String>) {
+        for e in std::fs::read_dir(d).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                walk(root, &p, out);
+            } else {
+                out.push(p.strip_prefix(root).unwrap().to_str().unwrap().replace('\\', "/"));
+            }
+        }
+    }
+    let mut out = Vec::new();
+    walk(dir, dir, &mut out);
+    out.sort();
+    out
+}
+
+/// Every file of `dir` with its bytes.
+fn contents(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    files(dir).into_iter().map(|f| (f.clone(), std::fs::read(dir.join(&f)).unwrap())).collect()
+}
+
 fn json(path: &Path) -> Value {
     let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     serde_json::from_str(&text).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
+/// The files the manifest of `dir` lists, sorted.
+fn listed(dir: &Path) -> Vec<String> {
+    let m = json(&dir.join("manifest.json"));
+    let mut l: Vec<String> = m["files"].as_array().expect("files").iter().map(|f| f["path"].as_str().unwrap().to_string()).collect();
+    l.sort();
+    l
+}
+
+#[test]
+fn a_reused_folder_is_refused_and_overwrite_leaves_only_the_new_run() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("out");
+    let twenty = scene_file(tmp.path(), "shear", "twenty.json", |v| v["output"]["frames"] = 20.into());
+    let five = scene_file(tmp.path(), "shear", "five.json", |v| v["output"]["frames"] = 5.into());
+    let run = |scene: &Path, extra: &[&str]| {
+        let mut args = vec!["run", s(scene), "--quiet", "--duration", "1e-4", "--out", s(&out)];
+        args.extend_from_slice(extra);
+        grainlab(&args)
+    };
+    let first = run(&twenty, &[]);
+    assert_eq!(code(&first), 0, "{}", stderr(&first));
+    let before = contents(&out);
+    let frames = |dir: &Path| files(dir).iter().filter(|f| f.starts_with("frames/")).count();
+    assert!(frames(&out) > 10, "{:?}", files(&out));
+    // Every file of the first run is in its manifest.
+    let mut written = listed(&out);
+    written.push("manifest.json".into());
+    written.sort();
+    assert_eq!(files(&out), written);
+
+    // Again into the same folder: refused, nothing touched.
+    let again = run(&five, &[]);
+    assert_eq!(code(&again), BAD_INPUT, "{}", stderr(&again));
+    assert!(stderr(&again).contains("--overwrite"), "{}", stderr(&again));
+    assert!(contents(&out) == before, "a refused run changed the folder");
+
+    // With --overwrite: only the second run's files remain (6 frames, not 21).
+    let second = run(&five, &["--overwrite"]);
+    assert_eq!(code(&second), 0, "{}", stderr(&second));
+    let n = frames(&out);
+    assert!(n <= 6, "{n} frames: {:?}", files(&out));
+    let pvd = std::fs::read_to_string(out.join("grains.pvd")).unwrap();
+    assert_eq!(pvd.matches("<DataSet").count(), n);
+    let mut written = listed(&out);
+    written.push("manifest.json".into());
+    written.sort();
+    assert_eq!(files(&out), written, "files the second run did not write");
+    let manifest = json(&out.join("manifest.json"));
+    assert_eq!(manifest["status"], "completed");
+    for f in manifest["files"].as_array().unwrap() {
+        let bytes = std::fs::read(out.join(f["path"].as_str().unwrap())).unwrap();
+        assert_eq!(f["bytes"].as_u64(), Some(bytes.len() as u64), "{f}");
+        assert_eq!(f["crc32"].as_str().unwrap(), format!("{:08x}", crc32(&bytes)), "{f}");
+    }
+}
+
+/// CRC-32 (IEEE), bit by bit: the manifest's checksum, computed independently.
+fn crc32(bytes: &[u8]) -> u32 {
+    let mut c = !0u32;
+    for &b in bytes {
+        c ^= b as u32;
+        for _ in 0..8 {
+            c = if c & 1 != 0 { (c >> 1) ^ 0xEDB8_8320 } else { c >> 1 };
+        }
+    }
+    !c
+}
+
+#[test]
+fn a_folder_with_files_grainlab_did_not_write_is_refused_and_left_as_it_was() {
+    let tmp = tempfile::tempdir().unwrap();
+    // A folder of someone else's files, with or without --overwrite.
+    let theirs = tmp.path().join("theirs");
+    std::fs::create_dir(&theirs).unwrap();
+    std::fs::write(theirs.join("notes.txt"), "mine").unwrap();
+    for extra in [&[][..], &["--overwrite"][..]] {
+        let mut args = vec!["run", "collision", "--quiet", "--out", s(&theirs)];
+        args.extend_from_slice(extra);
+        let o = grainlab(&args);
+        assert_eq!(code(&o), BAD_INPUT, "{args:?}: {}", stderr(&o));
+        assert!(stderr(&o).contains("notes.txt"), "{}", stderr(&o));
+        assert_eq!(files(&theirs), ["notes.txt"]);
+    }
+    // A folder grainlab wrote, with a file of someone else's added: --overwrite refuses
+    // too, and deletes nothing.
+    let mixed = tmp.path().join("mixed");
+    assert_eq!(code(&grainlab(&["run", "shear", "--quiet", "--duration", "1e-4", "--out", s(&mixed)])), 0);
+    std::fs::write(mixed.join("frames").join("plot.png"), "png").unwrap();
+    let before = contents(&mixed);
+    let o = grainlab(&["run", "shear", "--quiet", "--duration", "1e-4", "--out", s(&mixed), "--overwrite"]);
+    assert_eq!(code(&o), BAD_INPUT, "{}", stderr(&o));
+    assert!(stderr(&o).contains("plot.png"), "{}", stderr(&o));
+    assert!(contents(&mixed) == before, "a refused run changed the folder");
+    // A file grainlab wrote and someone changed is not deleted either.
+    let changed = tmp.path().join("changed");
+    assert_eq!(code(&grainlab(&["run", "collision", "--quiet", "--out", s(&changed)])), 0);
+    std::fs::write(changed.join("summary.json"), "{}").unwrap();
+    let o = grainlab(&["run", "collision", "--quiet", "--out", s(&changed), "--overwrite"]);
+    assert_eq!(code(&o), BAD_INPUT, "{}", stderr(&o));
+    assert!(stderr(&o).contains("summary.json"), "{}", stderr(&o));
+    assert_eq!(std::fs::read_to_string(changed.join("summary.json")).unwrap(), "{}");
+    // An export follows the same rule.
+    let o = grainlab(&["export", "liggghts", "oblique", "--out", s(&theirs)]);
+    assert_eq!(code(&o), BAD_INPUT, "{}", stderr(&o));
+    assert_eq!(files(&theirs), ["notes.txt"]);
+    let deck = tmp.path().join("deck");
+    assert_eq!(code(&grainlab(&["export", "liggghts", "oblique", "--out", s(&deck)])), 0);
+    assert_eq!(code(&grainlab(&["export", "yade", "oblique", "--out", s(&deck)])), BAD_INPUT);
+    assert_eq!(code(&grainlab(&["export", "yade", "oblique", "--out", s(&deck), "--overwrite"])), 0);
+    assert!(!deck.join("in.liggghts").exists(), "the first export's deck is still there");
+    assert!(deck.join("yade.py").exists());
+}
+
+fn start_shear(out: &Path) -> Child {
+    Command::new(BIN)
+        .args(["run", "shear", "--quiet", "--out", s(out)])
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap()
+}
+
+/// Lines of the energy series, under its temporary name while the run goes.
+fn energy_lines(out: &Path) -> usize {
+    ["energy.csv.part", "energy.csv"].iter().filter_map(|f| std::fs::read_to_string(out.join(f)).ok()).map(|t| t.lines().count()).max().unwrap_or(0)
+}
+
+/// Wait until the run has written `n` lines of its energy series (it is stepping).
+fn wait_for_rows(child: &mut Child, out: &Path, n: usize) {
+    let t0 = Instant::now();
+    while energy_lines(out) < n {
+        assert!(child.try_wait().unwrap().is_none(), "the run ended before it was interrupted");
+        assert!(t0.elapsed() < Duration::from_secs(300), "no rows after 300 s");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
+fn signal(child: &Child, sig: i32) {
+    assert_eq!(unsafe { libc::kill(child.id() as i32, sig) }, 0);
+}
+
+/// The child's output once it has exited (at most `secs` s).
+fn finish(mut child: Child, secs: u64) -> Output {
+    let t0 = Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if t0.elapsed() > Duration::from_secs(secs) {
+            child.kill().unwrap();
+            panic!("still running {secs} s after the signal");
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    child.wait_with_output().unwrap()
+}
+
+/// The numbers of a CSV series: a header and at least `min` rows of finite numbers.
+fn csv_rows(path: &Path, min: usize) -> usize {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let rows: Vec<&str> = text.lines().skip(1).collect();
+    assert!(rows.len() >= min, "{}: {} rows", path.display(), rows.len());
+    for r in &rows {
+        for v in r.split(',') {
+            let x: f64 = v.parse().unwrap_or_else(|_| panic!("{}: `{r}`", path.display()));
+            assert!(x.is_finite(), "{}: `{r}`", path.display());
+        }
+    }
+    rows.len()
+}
+
+/// A run killed outright keeps its series under their temporary names, listed in a
+/// manifest that says it was running; `--overwrite` clears them.
+#[test]
+fn a_killed_run_keeps_its_rows_and_its_folder_can_be_overwritten() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("out");
+    let mut child = start_shear(&out);
+    wait_for_rows(&mut child, &out, 5);
+    signal(&child, libc::SIGKILL);
+    let _ = finish(child, 60);
+    assert!(csv_rows(&out.join("energy.csv.part"), 4) >= 4);
+    assert!(!out.join("summary.json").exists());
+    let manifest = json(&out.join("manifest.json"));
+    assert_eq!(manifest["status"], "running");
+    assert!(listed(&out).contains(&"energy.csv.part".to_string()), "{manifest}");
+    let again = grainlab(&["run", "shear", "--quiet", "--duration", "1e-4", "--out", s(&out)]);
+    assert_eq!(code(&again), BAD_INPUT, "{}", stderr(&again));
+    let again = grainlab(&["run", "shear", "--quiet", "--duration", "1e-4", "--out", s(&out), "--overwrite"]);
+    assert_eq!(code(&again), 0, "{}", stderr(&again));
+    let mut written = listed(&out);
+    written.push("manifest.json".into());
+    written.sort();
+    assert_eq!(files(&out), written);
+    assert!(!out.join("energy.csv.part").exists());
 }
 
 /// `grainlab scenes shear | head -3`: stdout closed before the command writes to it.
