@@ -3,11 +3,13 @@
 use std::io::Write as _;
 use std::path::PathBuf;
 use std::process::ExitCode;
+use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use clap::{Parser, Subcommand};
 use grainlab::output::{csv::CsvSeries, folder::OutFolder};
-use grainlab::run::{RunOptions, run_scene, timing_table};
+use grainlab::error::exit;
+use grainlab::run::{RunOptions, RunReport, run_report, run_scene, timing_table};
 use grainlab::scenes::{BUILTIN, builtin};
 use grainlab::{Error, Scene, build};
 
@@ -135,6 +137,21 @@ const EXIT_CODES: &str = "Exit codes:
   4    run stopped unstable, with a diagnosis
   130  interrupted by SIGINT or SIGTERM, everything written";
 
+/// A flag that SIGINT and SIGTERM set: the run then ends after the step under way and
+/// writes everything (`status: "interrupted"`). A second signal ends the process at once,
+/// with the same exit code.
+fn interrupt_flag() -> Result<Arc<AtomicBool>, Error> {
+    use signal_hook::consts::{SIGINT, SIGTERM};
+    let flag = Arc::new(AtomicBool::new(false));
+    for sig in [SIGINT, SIGTERM] {
+        let failed = |e| Error::io(format!("installing a handler for signal {sig}"), e);
+        // First the exit, which sees the flag only a first signal has set.
+        signal_hook::flag::register_conditional_shutdown(sig, exit::INTERRUPTED.into(), Arc::clone(&flag)).map_err(failed)?;
+        signal_hook::flag::register(sig, Arc::clone(&flag)).map_err(failed)?;
+    }
+    Ok(flag)
+}
+
 /// Set when stdout's reader has gone (`grainlab scenes shear | head -3`).
 static STDOUT_CLOSED: AtomicBool = AtomicBool::new(false);
 
@@ -181,18 +198,31 @@ fn execute(cli: Cli) -> Result<(), Error> {
             }
             let built = grainlab::build_with(&scene, threads)?;
             note!("{}", built.explain());
-            let opts = RunOptions { out: out.clone(), overwrite, progress: !quiet, duration };
-            let summary = grainlab::run::run_built(&scene, built, &opts)?;
+            let opts = RunOptions { out: out.clone(), overwrite, progress: !quiet, duration, stop: Some(interrupt_flag()?) };
+            let RunReport { summary, ending, write_error, unwritten } = run_report(&scene, built, &opts)?;
             note!("{}", timing_table(&summary).trim_end());
             if let Some(w) = summary.energy.as_ref().and_then(|e| e.warning.as_ref()) {
                 note!("warning: {w}");
             }
-            say!("{}", serde_json::to_string_pretty(&summary).expect("serialisable"))?;
-            if let Some(dir) = out {
-                note!("wrote {}", dir.display());
-            }
+            // Always printed: when summary.json could not be written, this is its copy.
+            let printed = say!("{}", serde_json::to_string_pretty(&summary).expect("serialisable"));
+            let dir = out.as_deref().unwrap_or(std::path::Path::new("")).display();
             let _ = run_scene;
-            Ok(())
+            match (write_error, ending) {
+                (Some(failed), ending) => {
+                    if let Some(end) = ending {
+                        note!("error: {end}");
+                    }
+                    note!("error: could not write {} in {dir}; the summary is on stdout", unwritten.join(", "));
+                    Err(failed)
+                }
+                (None, ending) => {
+                    if out.is_some() {
+                        note!("wrote {dir}");
+                    }
+                    ending.map_or(printed, Err)
+                }
+            }
         }
         Command::Handover { threads, samples } => {
             say!("{}", serde_json::to_string_pretty(&grainlab::threads::hand_over_summary(threads, samples)?).expect("numbers serialise"))

@@ -2,6 +2,8 @@
 //! stage timing table.
 
 use std::path::PathBuf;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressStyle};
@@ -30,6 +32,10 @@ pub struct RunOptions {
     pub progress: bool,
     /// Override the scene's duration, s.
     pub duration: Option<f64>,
+    /// Set (by a SIGINT/SIGTERM handler, or a test) to end the run after the step under
+    /// way: it then writes everything with `status: "interrupted"` and ends with
+    /// [`Error::Interrupted`]. Read once a step (a relaxed atomic load).
+    pub stop: Option<Arc<AtomicBool>>,
 }
 
 
@@ -129,15 +135,49 @@ pub fn schedule(duration: f64, dt: f64, samples: u64) -> (u64, u64) {
     (total, (total / samples.max(1)).max(1))
 }
 
+/// How a run ended: its summary, also when it stopped early, and what went wrong.
+#[derive(Debug)]
+pub struct RunReport {
+    pub summary: Summary,
+    /// Why the run did not complete: a diagnosis ([`Error::Unstable`]), a stop request
+    /// ([`Error::Interrupted`]) or an output it could not write while it went
+    /// ([`Error::Io`]); the summary's `status` and `error` say the same.
+    pub ending: Option<Error>,
+    /// The first failure to write the outputs when the run ended (the series' renames,
+    /// `force_overlap.csv`, `summary.json`, the manifest), after trying them all.
+    pub write_error: Option<Error>,
+    /// The outputs that failed then, in the order they were tried.
+    pub unwritten: Vec<String>,
+}
+
+impl RunReport {
+    /// The summary of a completed run whose outputs are all written, else the error: a
+    /// write failure first (the folder is incomplete), then the ending.
+    pub fn into_result(self) -> Result<Summary, Error> {
+        let RunReport { summary, ending, write_error, .. } = self;
+        match (write_error, ending) {
+            (Some(err), _) | (None, Some(err)) => Err(err),
+            (None, None) => Ok(summary),
+        }
+    }
+}
+
 /// Build and run a scene.
 pub fn run_scene(scene: &Scene, opts: &RunOptions) -> Result<Summary, Error> {
     let built = build(scene)?;
     run_built(scene, built, opts)
 }
 
-/// Run an engine built from `scene`. On an unstable run the outputs written so far are
-/// kept, `summary.json` says what happened, and the error is returned.
-pub fn run_built(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<Summary, Error> {
+/// Run an engine built from `scene`. A run that stops early (unstable, interrupted, or an
+/// output it cannot write) still writes everything it can, `summary.json` says what
+/// happened, and the error is returned; [`run_report`] returns the summary with it.
+pub fn run_built(scene: &Scene, built: Built, opts: &RunOptions) -> Result<Summary, Error> {
+    run_report(scene, built, opts)?.into_result()
+}
+
+/// Run an engine built from `scene` and report how it ended ([`RunReport`]). An error
+/// here means the run did not start (its output folder refused or not writable).
+pub fn run_report(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<RunReport, Error> {
     let duration = opts.duration.unwrap_or(scene.duration);
     let dt = built.time_step.dt_s;
     let (total, sample_every) = schedule(duration, dt, scene.output.samples);
@@ -178,8 +218,19 @@ pub fn run_built(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<S
         }
         Ok(())
     };
-    record_energy(e, &mut outputs)?;
-    outputs.frame(e)?;
+    // Why the run stops early, if it does, and the first output that failed besides.
+    let mut error: Option<Error> = record_energy(e, &mut outputs).and_then(|()| outputs.frame(e)).err();
+    let mut write_error: Option<Error> = None;
+    // An output that cannot be written stops the run; what it computed is summarised.
+    macro_rules! or_stop {
+        ($written:expr) => {
+            if let Err(err) = $written {
+                error = Some(err);
+                break;
+            }
+        };
+    }
+    let stop = opts.stop.as_deref();
     let bar = if opts.progress {
         let b = ProgressBar::new(total);
         b.set_style(ProgressStyle::with_template("{msg} [{bar:40}] {percent}% {elapsed_precise} eta {eta}").expect("template").progress_chars("=> "));
@@ -189,11 +240,13 @@ pub fn run_built(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<S
         None
     };
     let t0 = Instant::now();
-    let mut error: Option<Error> = None;
-    for k in 1..=total {
+    let steps = if error.is_none() { total } else { 0 };
+    for k in 1..=steps {
+        // A stop request makes this step the last, sampled like the last of the run.
+        let stopping = stop.is_some_and(|s| s.load(Ordering::Relaxed));
         // Whether anything below looks at the grains after this step: else the step's
         // final half kick is left to the next one's drift.
-        let look = impact.is_some() || k % sample_every == 0 || k == total || frame_every.is_some_and(|every| k % every == 0);
+        let look = stopping || impact.is_some() || k % sample_every == 0 || k == total || frame_every.is_some_and(|every| k % every == 0);
         if let Err(err) = e.advance(look) {
             error = Some(err);
             break;
@@ -202,33 +255,39 @@ pub fn run_built(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<S
             o.observe(e);
         }
         walls_avg.accumulate(e);
-        if k % sample_every == 0 || k == total {
+        if k % sample_every == 0 || k == total || stopping {
             if let Err(err) = e.health() {
                 error = Some(err);
-                record_energy(e, &mut outputs)?;
+                if let Err(w) = record_energy(e, &mut outputs) {
+                    write_error = Some(w);
+                }
                 break;
             }
-            record_energy(e, &mut outputs)?;
+            or_stop!(record_energy(e, &mut outputs));
             if let Some(row) = walls_avg.row(e, built.length, built.depth) {
                 if let Some(w) = outputs.walls.as_mut() {
-                    w.row(&row)?;
+                    or_stop!(w.row(&row));
                 }
                 wall_rows.push(row);
             }
         }
         if frame_every.is_some_and(|every| k % every == 0) {
-            outputs.frame(e)?;
+            or_stop!(outputs.frame(e));
         }
         if k % 1000 == 0 {
             if let Some(b) = &bar {
                 b.set_position(k);
             }
         }
+        if stopping {
+            error = Some(Error::Interrupted { step: e.steps(), time: e.time() });
+            break;
+        }
         if impact.as_ref().is_some_and(|o| o.finished()) {
             if let Err(err) = e.health() {
                 error = Some(err);
             }
-            record_energy(e, &mut outputs)?;
+            or_stop!(record_energy(e, &mut outputs));
             break;
         }
     }
@@ -243,7 +302,12 @@ pub fn run_built(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<S
     let p = e.particles();
     let summary = Summary {
         scene: scene.name.clone(),
-        status: if error.is_some() { "stopped".into() } else { "completed".into() },
+        status: match &error {
+            None => "completed",
+            Some(Error::Interrupted { .. }) => "interrupted",
+            Some(_) => "stopped",
+        }
+        .into(),
         error: error.as_ref().map(|e| e.to_string()),
         model: e.model(),
         pipeline,
@@ -258,29 +322,27 @@ pub fn run_built(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<S
         shear,
         stage_timing,
     };
-    // Everything is written even when one write fails; the first failure is kept.
-    let mut write_error: Option<Error> = None;
+    // Everything is tried even when one write fails; the first failure is kept.
+    let mut unwritten = Vec::new();
     if let Some(folder) = outputs.folder.as_mut() {
-        let mut keep = |r: Result<(), Error>| {
+        let mut keep = |name: &str, r: Result<(), Error>| {
             if let Err(e) = r {
+                unwritten.push(name.to_string());
                 write_error.get_or_insert(e);
             }
         };
         for (series, name) in [(outputs.energy.take(), "energy.csv"), (outputs.walls.take(), "walls.csv")] {
             if let Some(s) = series {
-                keep(folder.close_series(s, name));
+                keep(name, folder.close_series(s, name));
             }
         }
         if let Some(o) = impact.as_ref() {
-            keep(folder.write_series("force_overlap.csv", &o.curve));
+            keep("force_overlap.csv", folder.write_series("force_overlap.csv", &o.curve));
         }
-        keep(folder.write("summary.json", (serde_json::to_string_pretty(&summary).expect("serialisable") + "\n").as_bytes()));
-        keep(folder.finish(&summary.status));
+        keep("summary.json", folder.write("summary.json", (serde_json::to_string_pretty(&summary).expect("serialisable") + "\n").as_bytes()));
+        keep("manifest.json", folder.finish(&summary.status));
     }
-    match (write_error, error) {
-        (Some(err), _) | (None, Some(err)) => Err(err),
-        (None, None) => Ok(summary),
-    }
+    Ok(RunReport { summary, ending: error, write_error, unwritten })
 }
 
 fn shear_summary(rows: &[WallRow], e: &dyn crate::build::Engine, length: f64) -> ShearSummary {

@@ -14,6 +14,7 @@ const BIN: &str = env!("CARGO_BIN_EXE_grainlab");
 const BAD_INPUT: i32 = 2;
 const IO_FAILURE: i32 = 3;
 const UNSTABLE: i32 = 4;
+const INTERRUPTED: i32 = 130;
 
 fn grainlab(args: &[&str]) -> Output {
     Command::new(BIN).args(args).stdin(Stdio::null()).output().unwrap()
@@ -239,6 +240,49 @@ fn csv_rows(path: &Path, min: usize) -> usize {
     rows.len()
 }
 
+fn interrupted_with(sig: i32) {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("out");
+    let mut child = start_shear(&out);
+    wait_for_rows(&mut child, &out, 8);
+    signal(&child, sig);
+    let o = finish(child, 60);
+    assert_eq!(code(&o), INTERRUPTED, "{}", stderr(&o));
+    assert!(!stderr(&o).contains("panicked"), "{}", stderr(&o));
+    let summary = json(&out.join("summary.json"));
+    assert_eq!(summary["status"], "interrupted", "{summary}");
+    assert!(summary["error"].as_str().unwrap().contains("interrupted"), "{summary}");
+    let steps = summary["steps"].as_u64().unwrap();
+    assert!(steps > 0);
+    for q in [&summary["simulated_time_s"], &summary["particle_steps_per_s"], &summary["energy"]["final_row"]["kinetic_translation_j"], &summary["shear"]["stress_ratio"]["mean"]] {
+        assert!(q.as_f64().is_some_and(f64::is_finite), "{q} in {summary}");
+    }
+    let printed: Value = serde_json::from_slice(&o.stdout).expect("the summary on stdout");
+    assert_eq!(printed["status"], "interrupted");
+    let energy = csv_rows(&out.join("energy.csv"), 8);
+    csv_rows(&out.join("walls.csv"), 7);
+    // The last energy row is the state the run stopped in.
+    let last = std::fs::read_to_string(out.join("energy.csv")).unwrap().lines().last().unwrap().to_string();
+    let t_last: f64 = last.split(',').next().unwrap().parse().unwrap();
+    assert_eq!(t_last, summary["simulated_time_s"].as_f64().unwrap(), "{energy} rows, last `{last}`");
+    let manifest = json(&out.join("manifest.json"));
+    assert_eq!(manifest["status"], "interrupted");
+    let mut written = listed(&out);
+    written.push("manifest.json".into());
+    written.sort();
+    assert_eq!(files(&out), written, "temporary or unlisted files");
+}
+
+#[test]
+fn sigint_ends_the_run_with_everything_written() {
+    interrupted_with(libc::SIGINT);
+}
+
+#[test]
+fn sigterm_ends_the_run_with_everything_written() {
+    interrupted_with(libc::SIGTERM);
+}
+
 /// A run killed outright keeps its series under their temporary names, listed in a
 /// manifest that says it was running; `--overwrite` clears them.
 #[test]
@@ -263,6 +307,23 @@ fn a_killed_run_keeps_its_rows_and_its_folder_can_be_overwritten() {
     written.sort();
     assert_eq!(files(&out), written);
     assert!(!out.join("energy.csv.part").exists());
+}
+
+/// The folder removed while the run goes: the run stops at the next file it cannot write,
+/// the summary goes to stdout, and the exit code is the I/O failure's.
+#[test]
+fn an_unwritable_summary_goes_to_stdout_with_the_io_exit_code() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("out");
+    let mut child = start_shear(&out);
+    wait_for_rows(&mut child, &out, 4);
+    std::fs::remove_dir_all(&out).unwrap();
+    let o = finish(child, 300);
+    assert_eq!(code(&o), IO_FAILURE, "{}", stderr(&o));
+    let printed: Value = serde_json::from_slice(&o.stdout).expect("the summary on stdout");
+    assert!(printed["steps"].as_u64().unwrap() > 0);
+    assert!(stderr(&o).contains("summary.json"), "{}", stderr(&o));
+    assert!(!stderr(&o).contains("panicked"), "{}", stderr(&o));
 }
 
 /// `grainlab scenes shear | head -3`: stdout closed before the command writes to it.
@@ -316,6 +377,8 @@ fn each_class_of_failure_has_its_exit_code() {
     assert_eq!(code(&o), UNSTABLE, "{}", stderr(&o));
     assert!(stderr(&o).contains("run stopped at step"), "{}", stderr(&o));
     assert_eq!(json(&out.join("summary.json"))["status"], "stopped");
+    let printed: Value = serde_json::from_slice(&o.stdout).expect("the summary on stdout");
+    assert_eq!(printed["status"], "stopped");
     // Other failures: reference output that cannot be read (a case folder whose
     // case.json is not one).
     let case = tmp.path().join("case");
@@ -325,4 +388,39 @@ fn each_class_of_failure_has_its_exit_code() {
     let o = grainlab(&["digest", s(&case), "liggghts", s(tmp.path())]);
     assert_eq!(code(&o), 1, "{}", stderr(&o));
     assert_eq!(code(&grainlab(&["run", "collision", "--quiet"])), 0);
+}
+
+/// The library's run with a stop request (what the signal handler sets) and a
+/// summary.json that cannot be written (a folder stands in its place): the summary comes
+/// back with the I/O error, everything else is written, and the manifest says so.
+#[test]
+fn a_stopped_run_returns_its_summary_when_summary_json_cannot_be_written() {
+    use grainlab::run::{RunOptions, run_report};
+    use std::sync::Arc;
+    use std::sync::atomic::{AtomicBool, Ordering};
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("out");
+    let scene = grainlab::scenes::builtin("shear").unwrap();
+    let built = grainlab::build(&scene).unwrap();
+    let stop = Arc::new(AtomicBool::new(false));
+    let opts = RunOptions { out: Some(out.clone()), stop: Some(stop.clone()), ..RunOptions::default() };
+    let run = std::thread::spawn(move || run_report(&scene, built, &opts));
+    let t0 = Instant::now();
+    while energy_lines(&out) < 4 {
+        assert!(!run.is_finished(), "the run ended before it was stopped");
+        assert!(t0.elapsed() < Duration::from_secs(300));
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    std::fs::create_dir_all(out.join("summary.json").join("in-the-way")).unwrap();
+    stop.store(true, Ordering::Relaxed);
+    let report = run.join().unwrap().expect("the run started");
+    assert_eq!(report.summary.status, "interrupted");
+    assert!(matches!(report.ending, Some(grainlab::Error::Interrupted { .. })), "{:?}", report.ending);
+    assert!(matches!(report.write_error, Some(grainlab::Error::Io { .. })), "{:?}", report.write_error);
+    assert_eq!(report.unwritten, ["summary.json"]);
+    assert!(report.summary.energy.as_ref().unwrap().final_row.kinetic_translation_j.is_finite());
+    csv_rows(&out.join("energy.csv"), 4);
+    csv_rows(&out.join("walls.csv"), 3);
+    assert_eq!(json(&out.join("manifest.json"))["status"], "interrupted");
+    assert_eq!(report.into_result().unwrap_err().exit_code(), IO_FAILURE as u8);
 }
