@@ -221,12 +221,22 @@ pub fn run_report(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<
     // Why the run stops early, if it does, and the first output that failed besides.
     let mut error: Option<Error> = record_energy(e, &mut outputs).and_then(|()| outputs.frame(e)).err();
     let mut write_error: Option<Error> = None;
+    let mut unwritten: Vec<String> = Vec::new();
     // An output that cannot be written stops the run; what it computed is summarised.
     macro_rules! or_stop {
         ($written:expr) => {
             if let Err(err) = $written {
                 error = Some(err);
                 break;
+            }
+        };
+    }
+    // An output that fails as the run ends anyway: named, and the others still written.
+    macro_rules! or_note {
+        ($name:expr, $written:expr) => {
+            if let Err(err) = $written {
+                unwritten.push($name.to_string());
+                write_error.get_or_insert(err);
             }
         };
     }
@@ -258,9 +268,7 @@ pub fn run_report(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<
         if k % sample_every == 0 || k == total || stopping {
             if let Err(err) = e.health() {
                 error = Some(err);
-                if let Err(w) = record_energy(e, &mut outputs) {
-                    write_error = Some(w);
-                }
+                or_note!("energy.csv", record_energy(e, &mut outputs));
                 break;
             }
             or_stop!(record_energy(e, &mut outputs));
@@ -287,7 +295,7 @@ pub fn run_report(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<
             if let Err(err) = e.health() {
                 error = Some(err);
             }
-            or_stop!(record_energy(e, &mut outputs));
+            or_note!("energy.csv", record_energy(e, &mut outputs));
             break;
         }
     }
@@ -323,24 +331,17 @@ pub fn run_report(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<
         stage_timing,
     };
     // Everything is tried even when one write fails; the first failure is kept.
-    let mut unwritten = Vec::new();
     if let Some(folder) = outputs.folder.as_mut() {
-        let mut keep = |name: &str, r: Result<(), Error>| {
-            if let Err(e) = r {
-                unwritten.push(name.to_string());
-                write_error.get_or_insert(e);
-            }
-        };
         for (series, name) in [(outputs.energy.take(), "energy.csv"), (outputs.walls.take(), "walls.csv")] {
             if let Some(s) = series {
-                keep(name, folder.close_series(s, name));
+                or_note!(name, folder.close_series(s, name));
             }
         }
         if let Some(o) = impact.as_ref() {
-            keep("force_overlap.csv", folder.write_series("force_overlap.csv", &o.curve));
+            or_note!("force_overlap.csv", folder.write_series("force_overlap.csv", &o.curve));
         }
-        keep("summary.json", folder.write("summary.json", (serde_json::to_string_pretty(&summary).expect("serialisable") + "\n").as_bytes()));
-        keep("manifest.json", folder.finish(&summary.status));
+        or_note!("summary.json", folder.write("summary.json", (serde_json::to_string_pretty(&summary).expect("serialisable") + "\n").as_bytes()));
+        or_note!("manifest.json", folder.finish(&summary.status));
     }
     Ok(RunReport { summary, ending: error, write_error, unwritten })
 }
