@@ -128,7 +128,8 @@ pub fn load_scene(arg: &str) -> Result<Scene, Error> {
     })
 }
 
-/// The exit codes, for `grainlab --help` (README, "Exit codes"; `grainlab::error::exit`).
+/// The exit codes, for `grainlab --help` (`grainlab::error::exit`; README, "The output
+/// folder, interruption and exit codes").
 const EXIT_CODES: &str = "Exit codes:
   0    success
   1    other failure (e.g. compare with comparisons outside their bound)

@@ -2,8 +2,8 @@
 
 use std::fmt;
 
-/// The exit codes of `grainlab` (README, "Exit codes"); [`Error::exit_code`] maps an
-/// error to its class.
+/// The exit codes of `grainlab` (README, "The output folder, interruption and exit
+/// codes"); [`Error::exit_code`] maps an error to its class.
 pub mod exit {
     /// Everything done as asked.
     pub const SUCCESS: u8 = 0;

@@ -1,7 +1,7 @@
 //! Outputs that lose nothing: the output folder is grainlab's (a reused folder never mixes
 //! two runs), SIGINT/SIGTERM end a run with everything written, an unwritable summary
 //! goes to stdout, a closed pipe ends quietly, and each class of failure has its exit
-//! code (README, "Exit codes").
+//! code (README, "The output folder, interruption and exit codes").
 
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Output, Stdio};
@@ -423,4 +423,22 @@ fn a_stopped_run_returns_its_summary_when_summary_json_cannot_be_written() {
     csv_rows(&out.join("walls.csv"), 3);
     assert_eq!(json(&out.join("manifest.json"))["status"], "interrupted");
     assert_eq!(report.into_result().unwrap_err().exit_code(), IO_FAILURE as u8);
+}
+
+/// The README's table and `grainlab --help` list exactly the codes of `error::exit`.
+#[test]
+fn the_exit_codes_are_documented() {
+    use grainlab::error::exit;
+    let mut codes = vec![exit::SUCCESS, exit::OTHER, exit::BAD_INPUT, exit::IO_FAILURE, exit::UNSTABLE, exit::INTERRUPTED];
+    codes.sort();
+    assert_eq!(codes, [0, 1, BAD_INPUT as u8, IO_FAILURE as u8, UNSTABLE as u8, INTERRUPTED as u8]);
+    let readme = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("README.md")).unwrap();
+    let section = &readme[readme.find("| exit code | meaning |").expect("the README's table")..];
+    let mut table: Vec<u8> = section.lines().skip(2).take_while(|l| l.starts_with('|')).map(|l| l.split('|').nth(1).unwrap().trim().parse().unwrap()).collect();
+    table.sort();
+    assert_eq!(table, codes);
+    let help = String::from_utf8(grainlab(&["--help"]).stdout).unwrap();
+    for c in codes {
+        assert!(help.lines().any(|l| l.trim_start().starts_with(&format!("{c} "))), "{c} in\n{help}");
+    }
 }
