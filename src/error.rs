@@ -42,7 +42,7 @@ pub enum Error {
     #[error("run stopped at step {step} (t = {time:.6e} s): {what}\n  what to change: {advice}")]
     Unstable { step: u64, time: f64, what: String, advice: String },
     /// A run ended early on request (SIGINT or SIGTERM), with everything written.
-    #[error("run interrupted at step {step} (t = {time:.6e} s) by SIGINT or SIGTERM; everything it computed is written")]
+    #[error("run interrupted at step {step} (t = {time:.6e} s) on a stop request (SIGINT or SIGTERM); everything it computed is written")]
     Interrupted { step: u64, time: f64 },
     #[error("{context}: {source}")]
     Io { context: String, source: std::io::Error },
