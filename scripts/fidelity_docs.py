@@ -29,7 +29,7 @@ def engine(case):
     """Run the engine on a case; return its output folder."""
     out = os.path.join(TMP, case.replace("/", "-"))
     if not os.path.exists(os.path.join(out, "summary.json")):
-        subprocess.run([GRAINLAB, "run", os.path.join(CASES, case, "scene.json"), "--out", out, "--quiet"],
+        subprocess.run([GRAINLAB, "run", os.path.join(CASES, case, "scene.json"), "--out", out, "--quiet", "--overwrite"],
                        check=True, capture_output=True)
     return out
 

@@ -1,17 +1,22 @@
 //! The command line: `grainlab run|explain|scenes|...` (`grainlab --help` lists them all).
 
+use std::io::Write as _;
 use std::path::PathBuf;
 use std::process::ExitCode;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use clap::{Parser, Subcommand};
-use grainlab::run::{RunOptions, run_scene, timing_table};
-use grainlab::build::build_limited;
-use grainlab::limits::Limits;
-use grainlab::scenes::BUILTIN;
 use grainlab::Error;
+use grainlab::build::build_limited;
+use grainlab::error::exit;
+use grainlab::limits::Limits;
+use grainlab::output::{csv::CsvSeries, folder::OutFolder};
+use grainlab::run::{RunOptions, RunReport, run_report, run_scene, timing_table};
+use grainlab::scenes::BUILTIN;
 
 #[derive(Parser)]
-#[command(name = "grainlab", version, about = "A 2D Hertz-Mindlin DEM engine, checked against LIGGGHTS and YADE")]
+#[command(name = "grainlab", version, about = "A 2D Hertz-Mindlin DEM engine, checked against LIGGGHTS and YADE", after_help = EXIT_CODES)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -26,9 +31,15 @@ enum Command {
     /// Run a scene (a built-in name or a JSON file).
     Run {
         scene: String,
-        /// Output directory for summary.json, CSV series and ParaView frames.
+        /// Output folder for summary.json, CSV series and ParaView frames: a new or
+        /// empty folder, or one grainlab wrote (see --overwrite); its manifest.json lists
+        /// what grainlab wrote.
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Delete the files an earlier grainlab command wrote in --out (those its
+        /// manifest.json lists) before the run. A folder holding anything else is refused.
+        #[arg(long)]
+        overwrite: bool,
         /// Override the scene's duration, s.
         #[arg(long)]
         duration: Option<f64>,
@@ -55,8 +66,12 @@ enum Command {
     Export {
         code: grainlab::export::Code,
         scene: String,
+        /// Output folder: new, empty, or one grainlab wrote (see --overwrite).
         #[arg(long)]
         out: PathBuf,
+        /// Delete the files an earlier grainlab command wrote in --out first.
+        #[arg(long)]
+        overwrite: bool,
         /// A timing deck: record nothing, print the loop time (scripts/bench-peers).
         #[arg(long)]
         bench: bool,
@@ -106,55 +121,130 @@ enum Command {
     Scenes { name: Option<String> },
 }
 
+/// The exit codes, for `grainlab --help` (`grainlab::error::exit`; README, "The output
+/// folder, interruption and exit codes").
+const EXIT_CODES: &str = "Exit codes:
+  0    success
+  1    other failure (e.g. compare with comparisons outside their bound)
+  2    bad input: a scene, an option value, or an output folder grainlab may not use
+  3    I/O failure (a summary that could not be written is on stdout)
+  4    run stopped unstable, with a diagnosis
+  130  interrupted by SIGINT or SIGTERM, everything written";
+
+/// A flag that SIGINT and SIGTERM set: the run then ends after the step under way and
+/// writes everything (`status: "interrupted"`). A second signal ends the process at once,
+/// with the same exit code.
+fn interrupt_flag() -> Result<Arc<AtomicBool>, Error> {
+    use signal_hook::consts::{SIGINT, SIGTERM};
+    let flag = Arc::new(AtomicBool::new(false));
+    for sig in [SIGINT, SIGTERM] {
+        let failed = |e| Error::io(format!("installing a handler for signal {sig}"), e);
+        // First the exit, which sees the flag only a first signal has set.
+        signal_hook::flag::register_conditional_shutdown(sig, exit::INTERRUPTED.into(), Arc::clone(&flag)).map_err(failed)?;
+        signal_hook::flag::register(sig, Arc::clone(&flag)).map_err(failed)?;
+    }
+    Ok(flag)
+}
+
+/// Set when stdout's reader has gone (`grainlab scenes shear | head -3`).
+static STDOUT_CLOSED: AtomicBool = AtomicBool::new(false);
+
+/// Write to stdout. A closed pipe is not an error: what follows is dropped and the
+/// command finishes its work and exits with its own code (0 for a listing), quietly. Any
+/// other failure (a full disk behind `> file`) is an I/O error.
+fn to_stdout(text: std::fmt::Arguments) -> Result<(), Error> {
+    if STDOUT_CLOSED.load(Ordering::Relaxed) {
+        return Ok(());
+    }
+    let mut out = std::io::stdout().lock();
+    match out.write_fmt(text).and_then(|()| out.flush()) {
+        Ok(()) => Ok(()),
+        Err(e) => {
+            STDOUT_CLOSED.store(true, Ordering::Relaxed);
+            if e.kind() == std::io::ErrorKind::BrokenPipe { Ok(()) } else { Err(Error::io("stdout", e)) }
+        }
+    }
+}
+
+/// `println!` through [`to_stdout`]: `say!(...)?`.
+macro_rules! say {
+    ($($arg:tt)*) => { to_stdout(format_args!("{}\n", format_args!($($arg)*))) };
+}
+
+/// `eprintln!` that does not panic when stderr is closed: a message nobody can read is
+/// dropped.
+macro_rules! note {
+    ($($arg:tt)*) => {{
+        let _ = writeln!(std::io::stderr().lock(), $($arg)*);
+    }};
+}
+
 fn execute(cli: Cli) -> Result<(), Error> {
     let limits = cli.memory_budget.map_or_else(Limits::machine, Limits::with_memory);
     let load_scene = |arg: &str| grainlab::scenes::load(arg, &limits);
     match cli.command {
-        Command::Run { scene, out, duration, quiet, threads } => {
+        Command::Run { scene, out, overwrite, duration, quiet, threads } => {
             let scene = load_scene(&scene)?;
             if let Some(d) = duration {
-                grainlab::error::check(d.is_finite() && d > 0.0, "", "--duration", d, "> 0 s")?;
+                grainlab::error::check_option(d.is_finite() && d > 0.0, "--duration", d, "> 0 s")?;
             }
-            let built = grainlab::build::build_limited(&scene, threads, &limits)?;
-            eprintln!("{}", built.explain());
-            let opts = RunOptions { out: out.clone(), progress: !quiet, duration };
-            let summary = grainlab::run::run_built(&scene, built, &opts)?;
-            eprint!("{}", timing_table(&summary));
+            if let Some(dir) = &out {
+                // Refused before a long build; the run claims the folder when it starts.
+                OutFolder::check(dir, overwrite)?;
+            }
+            let built = build_limited(&scene, threads, &limits)?;
+            note!("{}", built.explain());
+            let opts = RunOptions { out: out.clone(), overwrite, progress: !quiet, duration, stop: Some(interrupt_flag()?) };
+            let RunReport { summary, ending, write_error, unwritten } = run_report(&scene, built, &opts)?;
+            note!("{}", timing_table(&summary).trim_end());
             if let Some(w) = summary.energy.as_ref().and_then(|e| e.warning.as_ref()) {
-                eprintln!("warning: {w}");
+                note!("warning: {w}");
             }
-            println!("{}", serde_json::to_string_pretty(&summary).expect("serialisable"));
-            if let Some(dir) = out {
-                eprintln!("wrote {}", dir.display());
-            }
+            // Always printed: when summary.json could not be written, this is its copy.
+            let printed = say!("{}", serde_json::to_string_pretty(&summary).expect("serialisable"));
+            let dir = out.as_deref().unwrap_or(std::path::Path::new("")).display();
             let _ = run_scene;
-            Ok(())
+            match (write_error, ending) {
+                (Some(failed), ending) => {
+                    if let Some(end) = ending {
+                        note!("error: {end}");
+                    }
+                    note!("error: could not write {} in {dir}; the summary is on stdout", unwritten.join(", "));
+                    Err(failed)
+                }
+                (None, ending) => {
+                    if out.is_some() {
+                        note!("wrote {dir}");
+                    }
+                    ending.map_or(printed, Err)
+                }
+            }
         }
         Command::Handover { threads, samples } => {
-            println!("{}", serde_json::to_string_pretty(&grainlab::threads::hand_over_summary(threads, samples)?).expect("numbers serialise"));
-            Ok(())
+            say!("{}", serde_json::to_string_pretty(&grainlab::threads::hand_over_summary(threads, samples)?).expect("numbers serialise"))
         }
         Command::Explain { scene } => {
             let scene = load_scene(&scene)?;
-            println!("{}", build_limited(&scene, 1, &limits)?.explain());
-            Ok(())
+            say!("{}", build_limited(&scene, 1, &limits)?.explain())
         }
-        Command::Export { code, scene, out, bench } => {
+        Command::Export { code, scene, out, overwrite, bench } => {
             let scene = load_scene(&scene)?;
-            for path in grainlab::export::export_with(&scene, code, &out, bench)? {
-                println!("{}", path.display());
+            let files = grainlab::export::export_files(&scene, code, bench)?;
+            let mut folder = OutFolder::claim(&out, overwrite, &format!("export {} {}", code.name(), scene.name))?;
+            for (name, text) in files {
+                folder.write(name, text.as_bytes())?;
+                say!("{}", out.join(name).display())?;
             }
-            Ok(())
+            folder.finish("completed")
         }
         Command::Cases { root, filter } => {
             let n = grainlab::workbench::write_cases(&root, filter.as_deref())?;
-            eprintln!("wrote {n} cases under {}", root.display());
+            note!("wrote {n} cases under {}", root.display());
             Ok(())
         }
         Command::Digest { case_dir, code, run_dir } => {
             let out = grainlab::workbench::digest(&case_dir, code, &run_dir)?;
-            println!("{}", out.display());
-            Ok(())
+            say!("{}", out.display())
         }
         Command::Compare { root, filter, csv } => compare(&root, filter.as_deref(), csv.as_deref()),
         Command::Sweep { scene, steps, rayleigh, variants, duration, out } => {
@@ -167,40 +257,42 @@ fn execute(cli: Cli) -> Result<(), Error> {
                     Step::PerContact(n) => (n.is_finite() && n >= 1.0, n),
                     Step::Rayleigh(f) => (f > 0.0 && f <= 1.0, f),
                 };
-                grainlab::error::check(ok, "", if matches!(s, Step::PerContact(_)) { "--steps" } else { "--rayleigh" }, v, ">= 1 steps per contact, or a Rayleigh fraction in (0, 1]")?;
+                grainlab::error::check_option(ok, if matches!(s, Step::PerContact(_)) { "--steps" } else { "--rayleigh" }, v, ">= 1 steps per contact, or a Rayleigh fraction in (0, 1]")?;
             }
             let mut vars = vec![Variant::Scene];
             for f in &variants {
                 vars.extend(Variant::family(f)?);
             }
-            let rows = sweep(&scene, &st, &vars, duration, |r| eprintln!("{:<28} {:<16} dt = {:.3e} s  {:.1} ns/particle-step", r.variant, r.rule, r.dt_s, r.ns_per_particle_step))?;
+            let rows = sweep(&scene, &st, &vars, duration, |r| note!("{:<28} {:<16} dt = {:.3e} s  {:.1} ns/particle-step", r.variant, r.rule, r.dt_s, r.ns_per_particle_step))?;
             match out {
                 Some(path) => {
-                    let mut w = grainlab::output::csv::CsvSeries::create(&path)?;
+                    let mut w = CsvSeries::staged(&path)?;
                     for r in &rows {
                         w.row(r)?;
                     }
-                    eprintln!("wrote {}", path.display());
+                    w.finish()?;
+                    note!("wrote {}", path.display());
                 }
                 None => {
-                    let mut w = csv::Writer::from_writer(std::io::stdout());
+                    let mut w = csv::Writer::from_writer(Vec::new());
                     for r in &rows {
                         w.serialize(r).map_err(|e| Error::Other(e.to_string()))?;
                     }
+                    let text = w.into_inner().map_err(|e| Error::Other(e.to_string()))?;
+                    to_stdout(format_args!("{}", String::from_utf8_lossy(&text)))?;
                 }
             }
             Ok(())
         }
         Command::Scenes { name: None } => {
             for (n, d) in BUILTIN {
-                println!("{n:<10} {d}");
+                say!("{n:<10} {d}")?;
             }
             Ok(())
         }
         Command::Scenes { name: Some(n) } => {
             let s = load_scene(&n)?;
-            println!("{}", s.to_json());
-            Ok(())
+            say!("{}", s.to_json())
         }
     }
 }
@@ -214,10 +306,10 @@ fn compare(root: &std::path::Path, filter: Option<&str>, csv: Option<&std::path:
         }
         rows.extend(compare_case(&dir)?);
     }
-    println!("{:<40} {:<9} {:<32} {:>14} {:>14} {:>10} {:>9} pass", "case", "code", "quantity", "engine", "reference", "diff", "bound");
+    say!("{:<40} {:<9} {:<32} {:>14} {:>14} {:>10} {:>9} pass", "case", "code", "quantity", "engine", "reference", "diff", "bound")?;
     for r in &rows {
         let (d, kind) = if r.relative { (r.rel_diff, "rel") } else { (r.abs_diff, "abs") };
-        println!(
+        say!(
             "{:<40} {:<9} {:<32} {:>14.7e} {:>14.7e} {:>10.2e} {:>5.0e} {kind} {}",
             r.case,
             r.code.name(),
@@ -227,15 +319,16 @@ fn compare(root: &std::path::Path, filter: Option<&str>, csv: Option<&std::path:
             d,
             r.tolerance,
             if r.pass { "yes" } else { "NO" }
-        );
+        )?;
     }
     let failed = rows.iter().filter(|r| !r.pass).count();
-    eprintln!("{} comparisons, {} outside their bound", rows.len(), failed);
+    note!("{} comparisons, {} outside their bound", rows.len(), failed);
     if let Some(path) = csv {
-        let mut w = grainlab::output::csv::CsvSeries::create(path)?;
+        let mut w = CsvSeries::staged(path)?;
         for r in &rows {
             w.row(r)?;
         }
+        w.finish()?;
     }
     if failed > 0 {
         return Err(Error::Other(format!("{failed} comparisons outside their bound")));
@@ -247,8 +340,8 @@ pub fn main() -> ExitCode {
     match execute(Cli::parse()) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e}");
-            ExitCode::FAILURE
+            note!("error: {e}");
+            ExitCode::from(e.exit_code())
         }
     }
 }

@@ -3,18 +3,30 @@
 //! number that is NaN or infinite means the run went wrong and is never written.
 
 use serde::Serialize;
+use serde_value::Value;
 
-/// The header of the first column of `row` that holds NaN or an infinity, if any (an
-/// undefined quantity is an `Option`, written as an empty cell).
+/// The name (JSON-style path) of the first number in `row` that is NaN or infinite, if
+/// any. The row is read as a value tree (serde-value keeps the numbers as they are; an
+/// `Option` that is `None` is no number and passes).
 pub fn non_finite_column<T: Serialize>(row: &T) -> Option<String> {
-    let mut w = ::csv::Writer::from_writer(Vec::new());
-    w.serialize(row).ok()?;
-    let text = w.into_inner().ok()?;
-    let mut r = ::csv::Reader::from_reader(&text[..]);
-    let headers = r.headers().ok()?.clone();
-    let record = r.records().next()?.ok()?;
-    let bad = |v: &str| matches!(v.to_ascii_lowercase().as_str(), "nan" | "inf" | "-inf" | "+inf" | "infinity" | "-infinity");
-    record.iter().position(bad).map(|k| headers.get(k).unwrap_or("?").to_string())
+    fn find(v: &Value, at: &str) -> Option<String> {
+        match v {
+            Value::F64(x) if !x.is_finite() => Some(at.to_string()),
+            Value::F32(x) if !x.is_finite() => Some(at.to_string()),
+            Value::Option(Some(inner)) | Value::Newtype(inner) => find(inner, at),
+            Value::Seq(items) => items.iter().enumerate().find_map(|(k, x)| find(x, &format!("{at}[{k}]"))),
+            Value::Map(fields) => fields.iter().find_map(|(k, x)| {
+                let name = match k {
+                    Value::String(s) => s.clone(),
+                    other => format!("{other:?}"),
+                };
+                find(x, &if at.is_empty() { name } else { format!("{at}.{name}") })
+            }),
+            _ => None,
+        }
+    }
+    // A row that does not serialise has no number to check.
+    find(&serde_value::to_value(row).ok()?, "")
 }
 
 #[cfg(test)]

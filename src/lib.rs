@@ -31,7 +31,11 @@
 //! 5. **Observers** ([`observe`]): the energy balance, impact measurements, wall stresses,
 //!    with block-averaged confidence intervals ([`stats`]).
 //! 6. **Output** ([`output`]): `summary.json`, CSV time series with unit-suffixed headers,
-//!    ParaView `.vtp` frames with a `.pvd` index; [`run`] drives it all with a progress bar.
+//!    ParaView `.vtp` frames with a `.pvd` index, in an output folder that is grainlab's
+//!    (a manifest of what it wrote, files that appear whole; [`output::folder`]); [`run`]
+//!    drives it all with a progress bar, and ends early on a stop request (SIGINT,
+//!    SIGTERM) with everything written. Each class of failure has its exit code
+//!    ([`error::exit`]).
 //!
 //! Around a run:
 //!

@@ -2,6 +2,8 @@
 //! stage timing table.
 
 use std::path::PathBuf;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressStyle};
@@ -13,6 +15,7 @@ use crate::observe::energy::EnergyRow;
 use crate::observe::impact::{ImpactObserver, ImpactSummary};
 use crate::observe::stress::{WallAverager, WallRow};
 use crate::output::csv::CsvSeries;
+use crate::output::folder::OutFolder;
 use crate::output::vtk::VtkSeries;
 use crate::scene::{Analysis, Scene};
 use crate::stats::{Estimate, block_average};
@@ -20,12 +23,19 @@ use crate::timestep::TimeStepInfo;
 
 #[derive(Clone, Debug, Default)]
 pub struct RunOptions {
-    /// Output directory (created); nothing is written without one.
+    /// Output folder (created); nothing is written without one. It must be new, empty,
+    /// or hold an earlier grainlab output and `overwrite` be set ([`OutFolder`]).
     pub out: Option<PathBuf>,
+    /// Delete the files an earlier grainlab command listed in `out`'s manifest first.
+    pub overwrite: bool,
     /// Show a progress bar on stderr (when it is a terminal and the run is long).
     pub progress: bool,
     /// Override the scene's duration, s.
     pub duration: Option<f64>,
+    /// Set (by a SIGINT/SIGTERM handler, or a test) to end the run after the step under
+    /// way: it then writes everything with `status: "interrupted"` and ends with
+    /// [`Error::Interrupted`]. Read once a step (a relaxed atomic load).
+    pub stop: Option<Arc<AtomicBool>>,
 }
 
 
@@ -104,9 +114,19 @@ pub struct Summary {
 }
 
 struct Outputs {
+    folder: Option<OutFolder>,
     energy: Option<CsvSeries>,
     walls: Option<CsvSeries>,
     vtk: Option<VtkSeries>,
+}
+
+impl Outputs {
+    fn frame(&mut self, e: &dyn crate::build::Engine) -> Result<(), Error> {
+        match (self.vtk.as_mut(), self.folder.as_mut()) {
+            (Some(v), Some(f)) => v.frame(e, f),
+            _ => Ok(()),
+        }
+    }
 }
 
 /// Steps of a run of `duration` s at `dt`, and the steps per output sample: the schedule
@@ -133,15 +153,49 @@ pub fn step_count(duration: f64, dt: f64, field: &str) -> Result<u64, Error> {
     Ok(steps as u64)
 }
 
+/// How a run ended: its summary, also when it stopped early, and what went wrong.
+#[derive(Debug)]
+pub struct RunReport {
+    pub summary: Summary,
+    /// Why the run did not complete: a diagnosis ([`Error::Unstable`]), a stop request
+    /// ([`Error::Interrupted`]) or an output it could not write while it went
+    /// ([`Error::Io`]); the summary's `status` and `error` say the same.
+    pub ending: Option<Error>,
+    /// The first failure to write the outputs when the run ended (the series' renames,
+    /// `force_overlap.csv`, `summary.json`, the manifest), after trying them all.
+    pub write_error: Option<Error>,
+    /// The outputs that failed then, in the order they were tried.
+    pub unwritten: Vec<String>,
+}
+
+impl RunReport {
+    /// The summary of a completed run whose outputs are all written, else the error: a
+    /// write failure first (the folder is incomplete), then the ending.
+    pub fn into_result(self) -> Result<Summary, Error> {
+        let RunReport { summary, ending, write_error, .. } = self;
+        match (write_error, ending) {
+            (Some(err), _) | (None, Some(err)) => Err(err),
+            (None, None) => Ok(summary),
+        }
+    }
+}
+
 /// Build and run a scene.
 pub fn run_scene(scene: &Scene, opts: &RunOptions) -> Result<Summary, Error> {
     let built = build(scene)?;
     run_built(scene, built, opts)
 }
 
-/// Run an engine built from `scene`. On an unstable run the outputs written so far are
-/// kept, `summary.json` says what happened, and the error is returned.
-pub fn run_built(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<Summary, Error> {
+/// Run an engine built from `scene`. A run that stops early (unstable, interrupted, or an
+/// output it cannot write) still writes everything it can, `summary.json` says what
+/// happened, and the error is returned; [`run_report`] returns the summary with it.
+pub fn run_built(scene: &Scene, built: Built, opts: &RunOptions) -> Result<Summary, Error> {
+    run_report(scene, built, opts)?.into_result()
+}
+
+/// Run an engine built from `scene` and report how it ended ([`RunReport`]). An error
+/// here means the run did not start (its output folder refused or not writable).
+pub fn run_report(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<RunReport, Error> {
     let duration = opts.duration.unwrap_or(scene.duration);
     let dt = built.time_step.dt_s;
     // The build checked the scene's duration; an override is checked here.
@@ -149,18 +203,19 @@ pub fn run_built(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<S
     let (total, sample_every) = schedule(duration, dt, scene.output.samples);
     let frame_every = if scene.output.frames > 0 { Some((total / scene.output.frames).max(1)) } else { None };
     let energy_on = scene.output.energy;
-    let mut outputs = Outputs { energy: None, walls: None, vtk: None };
+    let mut outputs = Outputs { folder: None, energy: None, walls: None, vtk: None };
     if let Some(dir) = &opts.out {
-        std::fs::create_dir_all(dir).map_err(|e| Error::io(dir.display(), e))?;
+        let mut folder = OutFolder::claim(dir, opts.overwrite, &format!("run {}", scene.name))?;
         if energy_on {
-            outputs.energy = Some(CsvSeries::create(&dir.join("energy.csv"))?);
+            outputs.energy = Some(folder.series("energy.csv")?);
         }
         if !built.engine.walls().is_empty() {
-            outputs.walls = Some(CsvSeries::create(&dir.join("walls.csv"))?);
+            outputs.walls = Some(folder.series("walls.csv")?);
         }
         if frame_every.is_some() {
-            outputs.vtk = Some(VtkSeries::new(dir)?);
+            outputs.vtk = Some(VtkSeries::new(&mut folder)?);
         }
+        outputs.folder = Some(folder);
     }
     let pipeline = built.explain();
     let e = built.engine.as_mut();
@@ -183,10 +238,29 @@ pub fn run_built(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<S
         }
         Ok(())
     };
-    record_energy(e, &mut outputs)?;
-    if let (Some(v), Some(_)) = (outputs.vtk.as_mut(), frame_every) {
-        v.frame(e)?;
+    // Why the run stops early, if it does, and the first output that failed besides.
+    let mut error: Option<Error> = record_energy(e, &mut outputs).and_then(|()| outputs.frame(e)).err();
+    let mut write_error: Option<Error> = None;
+    let mut unwritten: Vec<String> = Vec::new();
+    // An output that cannot be written stops the run; what it computed is summarised.
+    macro_rules! or_stop {
+        ($written:expr) => {
+            if let Err(err) = $written {
+                error = Some(err);
+                break;
+            }
+        };
     }
+    // An output that fails as the run ends anyway: named, and the others still written.
+    macro_rules! or_note {
+        ($name:expr, $written:expr) => {
+            if let Err(err) = $written {
+                unwritten.push($name.to_string());
+                write_error.get_or_insert(err);
+            }
+        };
+    }
+    let stop = opts.stop.as_deref();
     let bar = if opts.progress {
         let b = ProgressBar::new(total);
         b.set_style(ProgressStyle::with_template("{msg} [{bar:40}] {percent}% {elapsed_precise} eta {eta}").expect("template").progress_chars("=> "));
@@ -196,11 +270,13 @@ pub fn run_built(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<S
         None
     };
     let t0 = Instant::now();
-    let mut error: Option<Error> = None;
-    for k in 1..=total {
+    let steps = if error.is_none() { total } else { 0 };
+    for k in 1..=steps {
+        // A stop request makes this step the last, sampled like the last of the run.
+        let stopping = stop.is_some_and(|s| s.load(Ordering::Relaxed));
         // Whether anything below looks at the grains after this step: else the step's
         // final half kick is left to the next one's drift.
-        let look = impact.is_some() || k % sample_every == 0 || k == total || frame_every.is_some_and(|every| k % every == 0);
+        let look = stopping || impact.is_some() || k % sample_every == 0 || k == total || frame_every.is_some_and(|every| k % every == 0);
         if let Err(err) = e.advance(look) {
             error = Some(err);
             break;
@@ -209,35 +285,41 @@ pub fn run_built(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<S
             o.observe(e);
         }
         walls_avg.accumulate(e);
-        let sample = k % sample_every == 0 || k == total;
+        let sample = k % sample_every == 0 || k == total || stopping;
         let frame = frame_every.is_some_and(|every| k % every == 0);
         // Nothing is written of a state that failed its check: outputs hold only finite
         // numbers, and the stop is diagnosed in the summary.
-        if (sample || frame)
-            && let Err(err) = e.health() {
+        if sample || frame {
+            if let Err(err) = e.health() {
                 error = Some(err);
                 break;
             }
+        }
         if sample {
-            record_energy(e, &mut outputs)?;
+            or_stop!(record_energy(e, &mut outputs));
             if let Some(row) = walls_avg.row(e, built.length, built.depth) {
                 if let Some(w) = outputs.walls.as_mut() {
-                    w.row(&row)?;
+                    or_stop!(w.row(&row));
                 }
                 wall_rows.push(row);
             }
         }
-        if let (Some(v), true) = (outputs.vtk.as_mut(), frame) {
-            v.frame(e)?;
+        if frame {
+            or_stop!(outputs.frame(e));
         }
-        if k % 1000 == 0
-            && let Some(b) = &bar {
+        if k % 1000 == 0 {
+            if let Some(b) = &bar {
                 b.set_position(k);
             }
+        }
+        if stopping {
+            error = Some(Error::Interrupted { step: e.steps(), time: e.time() });
+            break;
+        }
         if impact.as_ref().is_some_and(|o| o.finished()) {
             match e.health() {
                 Err(err) => error = Some(err),
-                Ok(()) => record_energy(e, &mut outputs)?,
+                Ok(()) => or_note!("energy.csv", record_energy(e, &mut outputs)),
             }
             break;
         }
@@ -253,7 +335,12 @@ pub fn run_built(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<S
     let p = e.particles();
     let summary = Summary {
         scene: scene.name.clone(),
-        status: if error.is_some() { "stopped".into() } else { "completed".into() },
+        status: match &error {
+            None => "completed",
+            Some(Error::Interrupted { .. }) => "interrupted",
+            Some(_) => "stopped",
+        }
+        .into(),
         error: error.as_ref().map(|e| e.to_string()),
         model: e.model(),
         pipeline,
@@ -268,20 +355,20 @@ pub fn run_built(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<S
         shear,
         stage_timing,
     };
-    if let Some(dir) = &opts.out {
-        let path = dir.join("summary.json");
-        std::fs::write(&path, serde_json::to_string_pretty(&summary).expect("serialisable")).map_err(|e| Error::io(path.display(), e))?;
-        if let Some(o) = impact.as_ref() {
-            let mut w = CsvSeries::create(&dir.join("force_overlap.csv"))?;
-            for c in &o.curve {
-                w.row(c)?;
+    // Everything is tried even when one write fails; the first failure is kept.
+    if let Some(folder) = outputs.folder.as_mut() {
+        for (series, name) in [(outputs.energy.take(), "energy.csv"), (outputs.walls.take(), "walls.csv")] {
+            if let Some(s) = series {
+                or_note!(name, folder.close_series(s, name));
             }
         }
+        if let Some(o) = impact.as_ref() {
+            or_note!("force_overlap.csv", folder.write_series("force_overlap.csv", &o.curve));
+        }
+        or_note!("summary.json", folder.write("summary.json", (serde_json::to_string_pretty(&summary).expect("serialisable") + "\n").as_bytes()));
+        or_note!("manifest.json", folder.finish(&summary.status));
     }
-    match error {
-        Some(err) => Err(err),
-        None => Ok(summary),
-    }
+    Ok(RunReport { summary, ending: error, write_error, unwritten })
 }
 
 fn shear_summary(rows: &[WallRow], e: &dyn crate::build::Engine, length: f64) -> ShearSummary {

@@ -53,7 +53,7 @@ impl Variant {
             "clamp" => vec![Variant::Clamp(false), Variant::Clamp(true)],
             "lever" => vec![Variant::Lever(LeverArm::Radius), Variant::Lever(LeverArm::RadiusMinusHalfOverlap), Variant::Lever(LeverArm::Yade)],
             _ => {
-                return Err(Error::Invalid { field: "--variants".into(), value: name.into(), allowed: "tangential, clamp, lever".into() });
+                return Err(Error::BadOption { option: "--variants".into(), value: name.into(), allowed: "tangential, clamp, lever".into() });
             }
         })
     }
@@ -110,7 +110,7 @@ fn abs_diff(a: Option<f64>, b: Option<f64>) -> Option<f64> {
 /// Run `scene` at every step setting for every variant.
 pub fn sweep(scene: &Scene, steps: &[Step], variants: &[Variant], duration: Option<f64>, mut progress: impl FnMut(&SweepRow)) -> Result<Vec<SweepRow>, Error> {
     if steps.is_empty() {
-        return Err(Error::Invalid { field: "--steps/--rayleigh".into(), value: "none".into(), allowed: "at least one time step".into() });
+        return Err(Error::BadOption { option: "--steps/--rayleigh".into(), value: "none".into(), allowed: "at least one time step".into() });
     }
     let speed = match scene.time_step.rule {
         TimeStepRule::StepsPerContact { impact_speed, .. } | TimeStepRule::Accuracy { impact_speed, .. } => impact_speed,

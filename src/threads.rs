@@ -29,7 +29,7 @@ pub struct HandOver {
 pub fn hand_over_summary(threads: usize, samples: usize) -> Result<HandOver, crate::error::Error> {
     Threads::check_count(threads, 2)?;
     if samples == 0 {
-        return Err(crate::error::Error::Invalid { field: "--samples".into(), value: "0".into(), allowed: ">= 1".into() });
+        return Err(crate::error::Error::BadOption { option: "--samples".into(), value: "0".into(), allowed: ">= 1".into() });
     }
     let pool = Threads::new(threads)?;
     let mut t = pool.hand_over_ns(samples);
@@ -91,7 +91,7 @@ impl Threads {
     /// A requested number of threads `n` (the `--threads` option) against what this build
     /// allows: at least `min`, and more than one only with the `parallel` feature.
     pub fn check_count(n: usize, min: usize) -> Result<(), crate::error::Error> {
-        let invalid = |allowed: String| Err(crate::error::Error::Invalid { field: "--threads".into(), value: n.to_string(), allowed });
+        let invalid = |allowed: String| Err(crate::error::Error::BadOption { option: "--threads".into(), value: n.to_string(), allowed });
         if n > 1 && !cfg!(feature = "parallel") {
             let only = if min <= 1 { "1" } else { "none" };
             return invalid(format!("{only} (this build has no `parallel` feature: cargo build --release --features parallel)"));

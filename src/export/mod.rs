@@ -214,6 +214,19 @@ pub fn export(scene: &Scene, code: Code, dir: &Path) -> Result<Vec<std::path::Pa
 /// cost the reference code time that grainlab's own timing does not include) and prints
 /// its loop time: LIGGGHTS' `Loop time of ...`, YADE's `grainlab-loop-seconds ...`.
 pub fn export_with(scene: &Scene, code: Code, dir: &Path, bench: bool) -> Result<Vec<std::path::PathBuf>, Error> {
+    let files = export_files(scene, code, bench)?;
+    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir.display(), e))?;
+    let mut written = Vec::new();
+    for (name, text) in files {
+        let path = dir.join(name);
+        crate::output::folder::write_atomic(&path, text.as_bytes())?;
+        written.push(path);
+    }
+    Ok(written)
+}
+
+/// What [`export_with`] writes, as (file name, text), without writing it.
+pub fn export_files(scene: &Scene, code: Code, bench: bool) -> Result<Vec<(&'static str, String)>, Error> {
     let mut ex = prepare(scene, code)?;
     ex.bench = bench;
     let b = bounds(&ex.built, scene.duration);
@@ -222,15 +235,7 @@ pub fn export_with(scene: &Scene, code: Code, dir: &Path, bench: bool) -> Result
         Code::Yade => yade::deck(scene, &ex)?,
     };
     let data = grains_data(scene, &ex.built, [[b[0][0], b[1][0]], [b[0][1], b[1][1]], [b[0][2], b[1][2]]]);
-    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir.display(), e))?;
-    let files = [(code.deck(), deck), ("grains.data", data), ("export.json", serde_json::to_string_pretty(&ex.info).expect("serialisable") + "\n")];
-    let mut written = Vec::new();
-    for (name, text) in files {
-        let path = dir.join(name);
-        std::fs::write(&path, text).map_err(|e| Error::io(path.display(), e))?;
-        written.push(path);
-    }
-    Ok(written)
+    Ok(vec![(code.deck(), deck), ("grains.data", data), ("export.json", serde_json::to_string_pretty(&ex.info).expect("serialisable") + "\n")])
 }
 
 /// Format a float so that it reads back to the same f64.

@@ -3,30 +3,87 @@
 //! keeps everything it computed.
 
 use std::fs::File;
-use std::io::BufWriter;
-use std::path::Path;
+use std::io::Write;
+use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
 use crate::error::Error;
+use crate::output::folder::{PART_SUFFIX, with_suffix};
+
+/// A writer that counts and checksums what goes through it (the manifest's size and
+/// CRC-32, without reading the file again).
+struct Counted {
+    file: File,
+    bytes: u64,
+    crc: crc32fast::Hasher,
+}
+
+impl Write for Counted {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        let n = self.file.write(buf)?;
+        self.bytes += n as u64;
+        self.crc.update(&buf[..n]);
+        Ok(n)
+    }
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.file.flush()
+    }
+}
 
 pub struct CsvSeries {
-    w: ::csv::Writer<BufWriter<File>>,
-    path: String,
+    w: ::csv::Writer<Counted>,
+    /// Where the rows go now.
+    path: PathBuf,
+    /// The name the file takes at [`CsvSeries::finish`], if not `path`.
+    final_path: Option<PathBuf>,
+}
+
+fn csv_error(path: &Path, e: ::csv::Error) -> Error {
+    if e.is_io_error() {
+        match e.into_kind() {
+            ::csv::ErrorKind::Io(io) => Error::io(path.display(), io),
+            _ => unreachable!("an I/O error"),
+        }
+    } else {
+        Error::Other(format!("{}: {e}", path.display()))
+    }
 }
 
 impl CsvSeries {
+    /// Write into `path` directly.
     pub fn create(path: &Path) -> Result<Self, Error> {
-        let f = File::create(path).map_err(|e| Error::io(path.display(), e))?;
-        Ok(CsvSeries { w: ::csv::Writer::from_writer(BufWriter::new(f)), path: path.display().to_string() })
+        Self::open(path, None)
     }
+
+    /// Write into `path.part`, renamed to `path` by [`CsvSeries::finish`]: `path` appears
+    /// only complete, and a process that dies leaves its rows under the `.part` name.
+    pub fn staged(path: &Path) -> Result<Self, Error> {
+        Self::open(&with_suffix(path, PART_SUFFIX), Some(path.to_path_buf()))
+    }
+
+    fn open(path: &Path, final_path: Option<PathBuf>) -> Result<Self, Error> {
+        let file = File::create(path).map_err(|e| Error::io(path.display(), e))?;
+        let counted = Counted { file, bytes: 0, crc: crc32fast::Hasher::new() };
+        Ok(CsvSeries { w: ::csv::Writer::from_writer(counted), path: path.to_path_buf(), final_path })
+    }
+
     /// Write a row; a row with a number that is not finite is refused (the run's checks
     /// stop a run before that, so this is the last line of defence: no output holds NaN).
     pub fn row<T: Serialize>(&mut self, row: &T) -> Result<(), Error> {
         if let Some(column) = crate::finite::non_finite_column(row) {
-            return Err(Error::Other(format!("{}: a row whose {column} is not finite was not written", self.path)));
+            return Err(Error::Other(format!("{}: a row whose {column} is not finite was not written", self.path.display())));
         }
-        self.w.serialize(row).map_err(|e| Error::Other(format!("{}: {e}", self.path)))?;
-        self.w.flush().map_err(|e| Error::io(&self.path, e))
+        self.w.serialize(row).map_err(|e| csv_error(&self.path, e))?;
+        self.w.flush().map_err(|e| Error::io(self.path.display(), e))
+    }
+
+    /// Flush, rename a staged series to its name, and return its size and CRC-32.
+    pub fn finish(self) -> Result<(u64, u32), Error> {
+        let counted = self.w.into_inner().map_err(|e| Error::io(self.path.display(), e.into_error()))?;
+        if let Some(to) = &self.final_path {
+            std::fs::rename(&self.path, to).map_err(|e| Error::io(to.display(), e))?;
+        }
+        Ok((counted.bytes, counted.crc.finalize()))
     }
 }

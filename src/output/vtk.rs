@@ -3,13 +3,13 @@
 //! Glyph filter (sphere, scale by `radius_m`) to see the grains.
 
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
 
 use crate::build::Engine;
 use crate::error::Error;
+use crate::output::folder::OutFolder;
 
+/// The frames of a run, in the `frames` sub-folder of its output folder.
 pub struct VtkSeries {
-    dir: PathBuf,
     frames: Vec<(f64, String)>,
 }
 
@@ -22,14 +22,14 @@ fn data_array(out: &mut String, name: &str, comps: usize, values: impl Iterator<
 }
 
 impl VtkSeries {
-    pub fn new(dir: &Path) -> Result<Self, Error> {
-        let dir = dir.join("frames");
-        std::fs::create_dir_all(&dir).map_err(|e| Error::io(dir.display(), e))?;
-        Ok(VtkSeries { dir, frames: Vec::new() })
+    pub fn new(folder: &mut OutFolder) -> Result<Self, Error> {
+        folder.folder("frames")?;
+        Ok(VtkSeries { frames: Vec::new() })
     }
 
-    /// Write one frame and rewrite the `.pvd` index.
-    pub fn frame(&mut self, e: &dyn Engine) -> Result<(), Error> {
+    /// Write one frame and rewrite the `.pvd` index (each a whole file, listed in the
+    /// folder's manifest).
+    pub fn frame(&mut self, e: &dyn Engine, folder: &mut OutFolder) -> Result<(), Error> {
         let p = e.particles();
         let n = p.len();
         // The last line of defence (the run checks the state before a frame): no frame
@@ -60,16 +60,14 @@ impl VtkSeries {
             let _ = write!(s, "{} ", i + 1);
         }
         s.push_str("\n        </DataArray>\n      </Verts>\n    </Piece>\n  </PolyData>\n</VTKFile>\n");
-        let name = format!("grains_{:05}.vtp", self.frames.len());
-        let path = self.dir.join(&name);
-        std::fs::write(&path, s).map_err(|e| Error::io(path.display(), e))?;
-        self.frames.push((e.time(), format!("frames/{name}")));
+        let name = format!("frames/grains_{:05}.vtp", self.frames.len());
+        folder.write(&name, s.as_bytes())?;
+        self.frames.push((e.time(), name));
         let mut pvd = String::from("<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n  <Collection>\n");
         for (t, f) in &self.frames {
             let _ = writeln!(pvd, "    <DataSet timestep=\"{t:e}\" part=\"0\" file=\"{f}\"/>");
         }
         pvd.push_str("  </Collection>\n</VTKFile>\n");
-        let index = self.dir.parent().expect("frames has a parent").join("grains.pvd");
-        std::fs::write(&index, pvd).map_err(|e| Error::io(index.display(), e))
+        folder.write("grains.pvd", pvd.as_bytes())
     }
 }
