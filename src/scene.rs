@@ -4,6 +4,7 @@
 //! validated as a whole before anything is built or written; an error names the field,
 //! the value and the allowed range.
 
+use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 use crate::contact::LeverArm;
@@ -12,7 +13,7 @@ use crate::error::{Error, check};
 use crate::material::Material;
 use crate::pack::RadiusDist;
 
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Scene {
     /// Name, used for output files.
@@ -53,7 +54,7 @@ fn default_materials() -> Vec<Material> {
     vec![Material::default()]
 }
 
-#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Domain {
     /// `[x_min, x_max]` of the periodic cell, m. Default: not periodic.
@@ -62,7 +63,7 @@ pub struct Domain {
 }
 
 /// Where the grains come from.
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case", deny_unknown_fields)]
 pub enum Grains {
     /// Grains listed one by one.
@@ -77,7 +78,7 @@ pub enum Grains {
     Pack(PackSpec),
 }
 
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct GrainSpec {
     /// Centre, m.
@@ -95,7 +96,7 @@ pub struct GrainSpec {
     pub material: usize,
 }
 
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct PackSpec {
     /// Number of grains.
@@ -125,7 +126,7 @@ fn default_fraction() -> f64 {
     0.75
 }
 
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct WallsSpec {
     pub bottom: WallSpec,
@@ -136,7 +137,7 @@ pub struct WallsSpec {
     pub thickness: Option<f64>,
 }
 
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct WallSpec {
     /// Position of the contact plane (flat) or of the glued grains' centres (rough), m.
@@ -161,7 +162,7 @@ pub struct WallSpec {
     pub material: usize,
 }
 
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case", deny_unknown_fields)]
 pub enum SurfaceSpec {
     #[default]
@@ -170,7 +171,7 @@ pub enum SurfaceSpec {
     Rough { radius: f64 },
 }
 
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case", deny_unknown_fields)]
 pub enum ControlSpec {
     #[default]
@@ -180,7 +181,7 @@ pub enum ControlSpec {
 }
 
 /// Tangential formulation.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum TangentialSpec {
     /// LIGGGHTS `tangential history`.
@@ -192,7 +193,7 @@ pub enum TangentialSpec {
     Frictionless,
 }
 
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ModelSpec {
     #[serde(default)]
@@ -224,7 +225,7 @@ impl Default for ModelSpec {
 }
 
 /// How the time step is chosen.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case", deny_unknown_fields)]
 pub enum TimeStepRule {
     /// A given dt, s.
@@ -242,7 +243,7 @@ pub enum TimeStepRule {
     Accuracy { quantity: crate::accuracy::AccuracyQuantity, tolerance: f64, impact_speed: f64 },
 }
 
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct TimeStepSpec {
     pub rule: TimeStepRule,
@@ -255,7 +256,7 @@ pub struct TimeStepSpec {
     pub allow_unstable: bool,
 }
 
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct NeighborSpec {
     /// Verlet skin as a fraction of the smallest grain diameter, > 0. Default 0.2.
@@ -273,7 +274,7 @@ impl Default for NeighborSpec {
     }
 }
 
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct OutputSpec {
     /// Rows of the time series (energy, walls). Default 200.
@@ -301,7 +302,7 @@ impl Default for OutputSpec {
 }
 
 /// What the summary reports.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum Analysis {
     #[default]
