@@ -165,3 +165,64 @@ fn thread_counts_this_build_cannot_give_are_refused_with_the_range() {
         assert!(err.contains("--threads") && err.contains(allowed), "{args:?}: {err}");
     }
 }
+
+/// Write `scene` to a file in `dir` and export it to `code` into `dir/out`.
+fn export_json(dir: &std::path::Path, code: &str, scene: &Value) -> assert_cmd::assert::Assert {
+    let file = dir.join(format!("{code}.json"));
+    std::fs::write(&file, serde_json::to_string(scene).unwrap()).unwrap();
+    let out = dir.join(format!("out-{code}"));
+    grainlab().args(["export", code, file.to_str().unwrap(), "--out", out.to_str().unwrap()]).assert()
+}
+
+fn deck_of(dir: &std::path::Path, code: &str, scene: &Value) -> String {
+    export_json(dir, code, scene).success();
+    std::fs::read_to_string(dir.join(format!("out-{code}")).join(if code == "yade" { "yade.py" } else { "in.liggghts" })).unwrap()
+}
+
+/// Names that run code when a deck pastes them into a comment as they are.
+const HOSTILE: [&str; 2] = ["x\nimport os; os.system('touch PWNED') #", "x\nshell touch PWNED #"];
+
+#[test]
+fn a_scene_name_adds_no_line_to_a_deck() {
+    // A line break in the name ended the comment: the rest was a YADE statement or a
+    // LIGGGHTS command (`shell` runs a program). Each deck and grains.data must have as
+    // many lines as with a plain name, and no line may begin with the payload.
+    let dir = tempfile::tempdir().unwrap();
+    let mut s = builtin_json("collision");
+    for code in ["liggghts", "yade"] {
+        s["name"] = "x".into();
+        let plain = deck_of(dir.path(), code, &s);
+        let plain_data = std::fs::read_to_string(dir.path().join(format!("out-{code}/grains.data"))).unwrap();
+        for name in HOSTILE {
+            s["name"] = name.into();
+            let deck = deck_of(dir.path(), code, &s);
+            let data = std::fs::read_to_string(dir.path().join(format!("out-{code}/grains.data"))).unwrap();
+            assert_eq!(deck.lines().count(), plain.lines().count(), "{code} {name:?}:\n{deck}");
+            assert_eq!(data.lines().count(), plain_data.lines().count(), "{code} {name:?}: grains.data");
+            assert!(!deck.lines().any(|l| l.starts_with("import os") || l.starts_with("shell")), "{code}:\n{deck}");
+        }
+    }
+}
+
+/// Run the reference codes on decks exported from scenes with hostile names: nothing may
+/// create the file, and each deck must still run. Needs `liggghts` and `yade` on PATH
+/// (scripts/setup-reference-tools): `cargo test --test cli -- --ignored hostile`.
+#[test]
+#[ignore]
+fn hostile_names_run_nothing_in_liggghts_and_yade() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut s = builtin_json("collision");
+    for name in HOSTILE {
+        s["name"] = name.into();
+        for (code, program, args) in [("liggghts", "liggghts", vec!["-in", "in.liggghts"]), ("yade", "yade", vec!["-j1", "-n", "-x", "yade.py"])] {
+            export_json(dir.path(), code, &s).success();
+            let run_dir = dir.path().join(format!("out-{code}"));
+            let out = std::process::Command::new(program).args(&args).current_dir(&run_dir).env("OMP_NUM_THREADS", "1").output().expect("the reference code is on PATH");
+            assert!(!run_dir.join("PWNED").exists(), "{code} ran the name {name:?}");
+            assert!(out.status.success(), "{code} failed on the deck of {name:?}:\n{}", String::from_utf8_lossy(&out.stderr));
+            assert!(run_dir.join("series.txt").exists(), "{code} wrote no series.txt");
+            std::fs::remove_dir_all(&run_dir).unwrap();
+        }
+    }
+}
+

@@ -10,7 +10,7 @@
 
 use std::fmt::Write as _;
 
-use super::{Exported, f};
+use super::{Exported, escaped, f};
 use crate::contact::LeverArm;
 use crate::error::Error;
 use crate::material::PairMaterial;
@@ -26,7 +26,7 @@ pub(crate) fn deck(scene: &Scene, ex: &Exported) -> Result<String, Error> {
     let n = mats.len();
     let mut s = String::new();
     let w = &mut s;
-    let _ = writeln!(w, "# LIGGGHTS 3.8.0 deck exported by grainlab {} from scene `{}`. Generated: do not edit;", env!("CARGO_PKG_VERSION"), scene.name);
+    let _ = writeln!(w, "# LIGGGHTS 3.8.0 deck exported by grainlab {} from scene `{}`. Generated: do not edit;", env!("CARGO_PKG_VERSION"), comment(&scene.name));
     let _ = writeln!(w, "# regenerate with `grainlab export liggghts SCENE --out DIR`.");
     let _ = writeln!(w, "# Run in this directory: liggghts -in in.liggghts (reads grains.data, writes {}).", if info.analysis == Analysis::Impact { "series.txt" } else { "walls.txt" });
     let _ = writeln!(w, "# Grains: spheres at z = 0 in a 3D box (the sphere-in-plane model); nothing moves them out of the plane.");
@@ -126,6 +126,15 @@ pub(crate) fn deck(scene: &Scene, ex: &Exported) -> Result<String, Error> {
     let _ = writeln!(w, "thermo_style custom step atoms\nthermo {}", (info.steps / 10).max(1));
     let _ = writeln!(w, "run {}", info.steps);
     Ok(s)
+}
+
+/// The scene name in a deck comment: [`escaped`], and `&` escaped too. LIGGGHTS reads a
+/// line ending in `&` (spaces aside) as continued by the next one before it strips the
+/// `#` comment (LIGGGHTS-PUBLIC src/input.cpp, `Input::file`), so a comment ending in `&`
+/// would swallow the next command. `$` and quotes need nothing: the comment is stripped
+/// before variables are substituted, and a `#` outside quotes starts it.
+pub(crate) fn comment(s: &str) -> String {
+    escaped(s, &['&'])
 }
 
 /// The LIGGGHTS atom type of a flat wall: its material + 1.

@@ -154,11 +154,30 @@ pub(crate) fn prepare(scene: &Scene, code: Code) -> Result<Exported, Error> {
     Ok(Exported { built, info, bench: false })
 }
 
+/// `s` as printable ASCII on one line: `\`, quotes, control and non-ASCII characters as
+/// Rust escapes (`\n`, `\u{e9}`), and each of `also` as `\u{..}`. This is how the
+/// scene name enters the decks' comments and the title line of grains.data: no line
+/// break can start a command (LIGGGHTS) or a statement (Python), and nothing outside
+/// printable ASCII reaches a reader that assumes an encoding.
+pub fn escaped(s: &str, also: &[char]) -> String {
+    let mut out = String::with_capacity(s.len());
+    for c in s.chars() {
+        if also.contains(&c) {
+            let _ = write!(out, "\\u{{{:x}}}", c as u32);
+        } else {
+            out.extend(c.escape_default());
+        }
+    }
+    out
+}
+
 /// The shared particle file, LAMMPS data format for `atom_style granular`.
 pub(crate) fn grains_data(scene: &Scene, built: &Built, bounds: [[f64; 2]; 3]) -> String {
     let p = built.engine.particles();
     let mut s = String::new();
-    let _ = writeln!(s, "grainlab grains of scene `{}`: id type diameter(m) density(kg/m^3) x y z (m); velocities: id vx vy vz (m/s) wx wy wz (rad/s)", scene.name);
+    // The title line: LIGGGHTS' read_data skips the first line whole, and the YADE script
+    // counts lines from it, so it must stay one line.
+    let _ = writeln!(s, "grainlab grains of scene `{}`: id type diameter(m) density(kg/m^3) x y z (m); velocities: id vx vy vz (m/s) wx wy wz (rad/s)", escaped(&scene.name, &[]));
     let _ = writeln!(s, "\n{} atoms\n{} atom types\n", p.len(), scene.materials.len());
     for (k, ax) in ["x", "y", "z"].iter().enumerate() {
         let _ = writeln!(s, "{:.17e} {:.17e} {ax}lo {ax}hi", bounds[k][0], bounds[k][1]);

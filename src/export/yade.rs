@@ -9,7 +9,7 @@
 
 use std::fmt::Write as _;
 
-use super::{Exported, f};
+use super::{Exported, escaped, f};
 use crate::error::Error;
 use crate::material::PairMaterial;
 use crate::scene::{Analysis, Scene, TangentialSpec};
@@ -29,7 +29,7 @@ pub(crate) fn deck(scene: &Scene, ex: &Exported) -> Result<String, Error> {
     let frictionless = model.tangential == TangentialSpec::Frictionless;
     let mut s = String::new();
     let w = &mut s;
-    let _ = writeln!(w, "# YADE 2023.02a script exported by grainlab {} from scene `{}`. Generated: do not edit;", env!("CARGO_PKG_VERSION"), scene.name);
+    let _ = writeln!(w, "# YADE 2023.02a script exported by grainlab {} from scene `{}`. Generated: do not edit;", env!("CARGO_PKG_VERSION"), escaped(&scene.name, &[]));
     let _ = writeln!(w, "# regenerate with `grainlab export yade SCENE --out DIR`.");
     let _ = writeln!(w, "# Run in this directory: yade -n -x yade.py (reads grains.data, writes series.txt).");
     let _ = writeln!(w, "# Recorded between the contact law and the integrator: positions x(n), force F(x(n)), velocities v(n-1/2).");
