@@ -48,12 +48,17 @@ enum Command {
     /// export.json into a directory.
     Export {
         code: grainlab::export::Code,
-        scene: String,
-        #[arg(long)]
-        out: PathBuf,
+        #[arg(required_unless_present = "explain_fields")]
+        scene: Option<String>,
+        #[arg(long, required_unless_present = "explain_fields")]
+        out: Option<PathBuf>,
         /// A timing deck: record nothing, print the loop time (scripts/bench-peers).
         #[arg(long)]
         bench: bool,
+        /// Print what each scene field becomes in this code's deck (what it cannot
+        /// express first) and write nothing.
+        #[arg(long, conflicts_with_all = ["scene", "out", "bench"])]
+        explain_fields: bool,
     },
     /// Write the workbench cases (scene, case.json, decks) under a root folder.
     Cases {
@@ -144,7 +149,12 @@ fn execute(cli: Cli) -> Result<(), Error> {
             println!("{}", build(&scene)?.explain());
             Ok(())
         }
-        Command::Export { code, scene, out, bench } => {
+        Command::Export { code, scene, out, bench, explain_fields } => {
+            if explain_fields {
+                print!("{}", grainlab::export::fields::explain(code));
+                return Ok(());
+            }
+            let (Some(scene), Some(out)) = (scene, out) else { unreachable!("clap requires SCENE and --out without --explain-fields") };
             let scene = load_scene(&scene)?;
             for path in grainlab::export::export_with(&scene, code, &out, bench)? {
                 println!("{}", path.display());

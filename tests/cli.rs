@@ -179,6 +179,69 @@ fn deck_of(dir: &std::path::Path, code: &str, scene: &Value) -> String {
     std::fs::read_to_string(dir.join(format!("out-{code}")).join(if code == "yade" { "yade.py" } else { "in.liggghts" })).unwrap()
 }
 
+#[test]
+fn export_refuses_general_damping_by_name() {
+    // The engine drags every free grain (F = -c m v, M = -c I w); neither LIGGGHTS'
+    // `fix viscous` (one gamma per type, no torque) nor YADE's damping (Cundall's, not
+    // viscous) is that drag. The deck used to come out as the undamped one.
+    let mut s = builtin_json("collision");
+    s["model"]["general_damping"] = 0.1.into();
+    let dir = tempfile::tempdir().unwrap();
+    for code in ["liggghts", "yade"] {
+        export_json(dir.path(), code, &s).failure().stderr(predicate::str::contains(format!("export to {code}: model.general_damping = 0.1 cannot be expressed")));
+        assert!(!dir.path().join(format!("out-{code}")).exists());
+    }
+}
+
+#[test]
+fn export_to_yade_blocks_spin_without_rotation() {
+    // model.rotation = false: the free grains must not spin in YADE either (the script
+    // used to be byte-identical to the rotating one).
+    let dir = tempfile::tempdir().unwrap();
+    let mut s = builtin_json("oblique");
+    let spinning = deck_of(dir.path(), "yade", &s);
+    s["model"]["rotation"] = false.into();
+    let fixed = deck_of(dir.path(), "yade", &s);
+    assert!(!spinning.contains("'zXYZ'") && fixed.contains("O.bodies[i].state.blockedDOFs = 'zXYZ'"), "{fixed}");
+    let liggghts = deck_of(dir.path(), "liggghts", &s);
+    assert!(liggghts.contains("fix integrate free nve\n"), "{liggghts}");
+}
+
+#[test]
+fn export_writes_or_refuses_the_loaded_walls_mass() {
+    // The shear cell's loaded top wall with twice its glued grains' mass: YADE sets the
+    // clump's mass; LIGGGHTS moves the row as its atoms and refuses by name. Both decks
+    // used to be the default-mass ones.
+    let mut s = builtin_json("shear");
+    s["grains"]["pack"]["count"] = 60.into();
+    s["grains"]["pack"]["x"] = serde_json::json!([0.0, 0.004]);
+    s["domain"]["periodic_x"] = serde_json::json!([0.0, 0.004]);
+    let dir = tempfile::tempdir().unwrap();
+    let default = deck_of(dir.path(), "yade", &s);
+    // Four glued grains of radius 0.5 mm (L = 4 mm): 4 x 4/3 pi r^3 x 2500 kg/m^3.
+    let glued = 4.0 * 4.0 / 3.0 * std::f64::consts::PI * 0.5e-3f64.powi(3) * 2500.0;
+    s["walls"]["top"]["mass"] = (2.0 * glued).into();
+    let heavy = deck_of(dir.path(), "yade", &s);
+    assert!(!default.contains("c.mass"), "{default}");
+    // The mass as the scene gives it (to the last bits serde_json's parser keeps).
+    let line = heavy.lines().find_map(|l| l.strip_prefix("c.mass = ")).unwrap_or_else(|| panic!("no clump mass:\n{heavy}"));
+    let m: f64 = line.split_whitespace().next().unwrap().parse().unwrap();
+    assert!((m / (2.0 * glued) - 1.0).abs() < 1e-15 && line.ends_with("# walls.top.mass, kg"), "{line}");
+    export_json(dir.path(), "liggghts", &s).failure().stderr(predicate::str::contains("export to liggghts: walls.top.mass = ").and(predicate::str::contains("cannot be expressed")));
+}
+
+#[test]
+fn export_notes_where_the_kinematics_differ() {
+    // The seed's lever arm r: LIGGGHTS uses r - dn/2, YADE its own ScGeom kinematics; both
+    // decks say so, naming the field. (The YADE script used to say nothing.)
+    let dir = tempfile::tempdir().unwrap();
+    let s = builtin_json("oblique");
+    for code in ["liggghts", "yade"] {
+        let deck = deck_of(dir.path(), code, &s);
+        assert!(deck.lines().any(|l| l.starts_with("# Differs: model.lever_arm = radius: ")), "{code}:\n{deck}");
+    }
+}
+
 /// Names that run code when a deck pastes them into a comment as they are.
 const HOSTILE: [&str; 2] = ["x\nimport os; os.system('touch PWNED') #", "x\nshell touch PWNED #"];
 
@@ -226,3 +289,17 @@ fn hostile_names_run_nothing_in_liggghts_and_yade() {
     }
 }
 
+#[test]
+fn export_lists_what_a_code_cannot_express() {
+    // --explain-fields prints the table of one code, what it refuses first, and writes nothing.
+    for (code, refused) in [("liggghts", "walls.top.mass:"), ("yade", "materials[].restitution:")] {
+        let out = grainlab().args(["export", code, "--explain-fields"]).output().unwrap();
+        assert!(out.status.success());
+        let text = String::from_utf8(out.stdout).unwrap();
+        let cannot = text.split("expressed approximately").next().unwrap();
+        assert!(cannot.contains("cannot be expressed") && cannot.contains("  model.general_damping:") && cannot.contains(refused), "{code}:\n{text}");
+        for f in grainlab::export::fields::FIELDS {
+            assert!(text.contains(&format!("  {}", f.path)), "{code}: {} missing", f.path);
+        }
+    }
+}

@@ -12,9 +12,17 @@
 //! Both decks write the same raw output in the working directory: `series.txt` (impact
 //! scenes: the state of grains 1 and 2 at every step) or `walls.txt` (wall scenes: wall
 //! forces averaged over each sample interval). `scripts/regen-reference` turns that into
-//! the reference CSV schema. What each code cannot express is refused with a clear
-//! error, and every approximation is written as a comment at the top of the deck.
+//! the reference CSV schema.
+//!
+//! The exporter is exact or refuses by name: [`fields`] holds, for every scene field and
+//! each code, whether it is written (and where), refused (`export to CODE: PATH = VALUE
+//! cannot be expressed: WHY`), expressed approximately (a `# Differs: PATH = VALUE: ...`
+//! line at the top of the deck) or not part of the physics a deck computes;
+//! tests/export_fields.rs walks the scene's schema and holds the exporter to that table.
+//! The scene name, the one string a deck carries, is escaped for each target
+//! ([`escaped`]).
 
+pub mod fields;
 pub mod liggghts;
 pub mod yade;
 
@@ -26,7 +34,7 @@ use serde::Serialize;
 use crate::build::{Built, build};
 use crate::dim::GrainShape;
 use crate::error::Error;
-use crate::scene::{Analysis, Scene};
+use crate::scene::{Analysis, ControlSpec, Grains, Scene, TangentialSpec};
 use crate::walls::{Control, Surface};
 
 /// The reference codes.
@@ -102,38 +110,48 @@ pub(crate) struct Exported {
 }
 
 pub(crate) fn prepare(scene: &Scene, code: Code) -> Result<Exported, Error> {
-    let unsupported = |what: &str| Err(Error::Other(format!("export to {}: {what}", code.name())));
-    if scene.grain_shape != GrainShape::SphereInPlane {
-        return unsupported("only grain_shape sphere_in_plane is exported (LIGGGHTS `dimension 2` disks are a different model)");
+    if let GrainShape::Disk { thickness } = scene.grain_shape {
+        return Err(fields::refuse(code, "grain_shape.disk.thickness", thickness, ""));
     }
-    if scene.gravity != [0.0, 0.0] {
-        return unsupported("gravity is not exported yet");
+    if let [gx, gy] = scene.gravity
+        && (gx != 0.0 || gy != 0.0)
+    {
+        return Err(fields::refuse(code, "gravity", format!("[{gx}, {gy}]"), ""));
+    }
+    if let Some(c) = scene.model.general_damping {
+        return Err(fields::refuse(code, "model.general_damping", c, ""));
+    }
+    if !scene.model.rotation
+        && scene.model.tangential != TangentialSpec::Frictionless
+        && let Grains::List(list) = &scene.grains
+        && let Some((k, g)) = list.iter().enumerate().find(|(_, g)| g.omega != 0.0)
+    {
+        return Err(fields::refuse(code, &format!("grains.list[{k}].omega"), g.omega, "model.rotation = false"));
     }
     let built = build(scene)?;
     let (steps, sample_every) = crate::run::schedule(scene.duration, built.time_step.dt_s, scene.output.samples);
     let e = built.engine.as_ref();
     let n_free = e.particles().n_free;
     let walls = e.walls();
-    if walls.iter().any(|w| w.is_flat() && w.control != Control::Fixed) {
-        return unsupported("a flat wall under a load has no primitive-wall equivalent; use a rough wall");
-    }
-    if walls.iter().any(|w| !w.is_flat() && w.name == "bottom" && w.control != Control::Fixed) {
-        return unsupported("only the top wall may carry a load");
+    if let Some(w) = walls.iter().find(|w| w.is_flat() && w.control != Control::Fixed) {
+        return Err(fields::refuse(code, &format!("walls.{}.control.pressure", w.name), pressure(scene, w.name), &format!("walls.{}.surface = flat", w.name)));
     }
     let columns = match scene.analysis {
         Analysis::Impact => {
             if n_free > 2 || (n_free == 1 && !walls.iter().any(|w| w.is_flat())) {
-                return unsupported("an impact scene has two grains, or one grain and a flat wall");
+                let what = if n_free > 2 { format!("{n_free} free grains") } else { "one grain and no flat wall".to_string() };
+                return Err(fields::refuse(code, "analysis", "impact", &what));
             }
             impact_columns(n_free == 2)
         }
         Analysis::Shear => {
-            if walls.iter().any(|w| w.is_flat()) {
-                return unsupported("the shear export needs rough walls");
+            if let Some(w) = walls.iter().find(|w| w.is_flat()) {
+                return Err(fields::refuse(code, &format!("walls.{}.surface", w.name), "flat", "analysis = shear"));
             }
             wall_columns()
         }
-        Analysis::None => return unsupported("only impact and shear scenes are exported (set `analysis`)"),
+        // The deck records nothing, as a timing deck.
+        Analysis::None => Vec::new(),
     };
     let p = e.particles();
     let impact = scene.analysis == Analysis::Impact;
@@ -152,6 +170,15 @@ pub(crate) fn prepare(scene: &Scene, code: Code) -> Result<Exported, Error> {
         columns,
     };
     Ok(Exported { built, info, bench: false })
+}
+
+/// The pressure a scene puts on wall `name` (`walls.NAME.control.pressure`), Pa; 0 if held.
+pub(crate) fn pressure(scene: &Scene, name: &str) -> f64 {
+    let w = scene.walls.as_ref().expect("a wall exists");
+    match if name == "bottom" { &w.bottom.control } else { &w.top.control } {
+        ControlSpec::Pressure(p) => *p,
+        ControlSpec::Fixed => 0.0,
+    }
 }
 
 /// `s` as printable ASCII on one line: `\`, quotes, control and non-ASCII characters as
@@ -233,6 +260,19 @@ pub fn export(scene: &Scene, code: Code, dir: &Path) -> Result<Vec<std::path::Pa
 /// cost the reference code time that grainlab's own timing does not include) and prints
 /// its loop time: LIGGGHTS' `Loop time of ...`, YADE's `grainlab-loop-seconds ...`.
 pub fn export_with(scene: &Scene, code: Code, dir: &Path, bench: bool) -> Result<Vec<std::path::PathBuf>, Error> {
+    let files = render(scene, code, bench)?;
+    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir.display(), e))?;
+    let mut written = Vec::new();
+    for (name, text) in files {
+        let path = dir.join(name);
+        std::fs::write(&path, text).map_err(|e| Error::io(path.display(), e))?;
+        written.push(path);
+    }
+    Ok(written)
+}
+
+/// What [`export_with`] writes, as (file name, text): the deck, grains.data, export.json.
+pub fn render(scene: &Scene, code: Code, bench: bool) -> Result<Vec<(&'static str, String)>, Error> {
     let mut ex = prepare(scene, code)?;
     ex.bench = bench;
     let b = bounds(&ex.built, scene.duration);
@@ -241,15 +281,7 @@ pub fn export_with(scene: &Scene, code: Code, dir: &Path, bench: bool) -> Result
         Code::Yade => yade::deck(scene, &ex)?,
     };
     let data = grains_data(scene, &ex.built, [[b[0][0], b[1][0]], [b[0][1], b[1][1]], [b[0][2], b[1][2]]]);
-    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir.display(), e))?;
-    let files = [(code.deck(), deck), ("grains.data", data), ("export.json", serde_json::to_string_pretty(&ex.info).expect("serialisable") + "\n")];
-    let mut written = Vec::new();
-    for (name, text) in files {
-        let path = dir.join(name);
-        std::fs::write(&path, text).map_err(|e| Error::io(path.display(), e))?;
-        written.push(path);
-    }
-    Ok(written)
+    Ok(vec![(code.deck(), deck), ("grains.data", data), ("export.json", serde_json::to_string_pretty(&ex.info).expect("serialisable") + "\n")])
 }
 
 /// Format a float so that it reads back to the same f64.
