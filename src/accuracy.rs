@@ -8,6 +8,7 @@
 //! finer step in the ladder, is within the tolerance. The calibration costs a few
 //! thousand two-grain steps (milliseconds) and `explain` reports its result.
 
+use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 use crate::error::Error;
@@ -17,7 +18,7 @@ use crate::run::{RunOptions, run_scene};
 use crate::scenes::head_on;
 
 /// The measured quantity a tolerance applies to.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum AccuracyQuantity {
     /// Realised normal restitution, absolute error.

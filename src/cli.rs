@@ -65,16 +65,21 @@ enum Command {
     /// export.json into a directory.
     Export {
         code: grainlab::export::Code,
-        scene: String,
+        #[arg(required_unless_present = "explain_fields")]
+        scene: Option<String>,
         /// Output folder: new, empty, or one grainlab wrote (see --overwrite).
-        #[arg(long)]
-        out: PathBuf,
+        #[arg(long, required_unless_present = "explain_fields")]
+        out: Option<PathBuf>,
         /// Delete the files an earlier grainlab command wrote in --out first.
         #[arg(long)]
         overwrite: bool,
         /// A timing deck: record nothing, print the loop time (scripts/bench-peers).
         #[arg(long)]
         bench: bool,
+        /// Print what each scene field becomes in this code's deck (what it cannot
+        /// express first) and write nothing.
+        #[arg(long, conflicts_with_all = ["scene", "out", "bench"])]
+        explain_fields: bool,
     },
     /// Write the workbench cases (scene, case.json, decks) under a root folder.
     Cases {
@@ -227,7 +232,11 @@ fn execute(cli: Cli) -> Result<(), Error> {
             let scene = load_scene(&scene)?;
             say!("{}", build_limited(&scene, 1, &limits)?.explain())
         }
-        Command::Export { code, scene, out, overwrite, bench } => {
+        Command::Export { code, scene, out, overwrite, bench, explain_fields } => {
+            if explain_fields {
+                return say!("{}", grainlab::export::fields::explain(code).trim_end());
+            }
+            let (Some(scene), Some(out)) = (scene, out) else { unreachable!("clap requires SCENE and --out without --explain-fields") };
             let scene = load_scene(&scene)?;
             let files = grainlab::export::export_files(&scene, code, bench)?;
             let mut folder = OutFolder::claim(&out, overwrite, &format!("export {} {}", code.name(), scene.name))?;

@@ -8,6 +8,7 @@
 //! - [`GrainShape::Disk`]: cylinders of a stated thickness t, m = pi r^2 t rho,
 //!   I = 1/2 m r^2 (LIGGGHTS `dimension 2` with t = 1 m).
 
+use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
@@ -27,7 +28,7 @@ pub fn spin_cross(w: f64, a: Vec2) -> Vec2 {
 }
 
 /// What a grain is in the third dimension.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize, JsonSchema, Default)]
 #[serde(rename_all = "snake_case", deny_unknown_fields)]
 pub enum GrainShape {
     /// Spheres confined to the plane: m = 4/3 pi r^3 rho, I = 2/5 m r^2.

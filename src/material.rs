@@ -6,12 +6,13 @@
 //! friction are the smaller of the two materials' values (YADE takes the smaller friction
 //! angle; LIGGGHTS needs a per-pair matrix, which the exporter writes from this rule).
 
+use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, check};
 
 /// One grain or wall material.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Material {
     /// A name for output and exported decks. Default `"glass"`.

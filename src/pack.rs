@@ -8,6 +8,7 @@
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, LogNormal, Normal};
+use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 use crate::boundary::Boundary;
@@ -16,7 +17,7 @@ use crate::error::{Error, check};
 use crate::neighbor::{Neighbours, bin_into_cells};
 
 /// A distribution of radii, m. Normal and lognormal draws are truncated to [min, max].
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case", deny_unknown_fields)]
 pub enum RadiusDist {
     Fixed { radius: f64 },

@@ -4,6 +4,7 @@
 //! validated as a whole before anything is built or written; an error names the field,
 //! the value and the allowed range.
 
+use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 use crate::contact::LeverArm;
@@ -13,7 +14,7 @@ use crate::limits::MAX_MATERIALS;
 use crate::material::Material;
 use crate::pack::RadiusDist;
 
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Scene {
     /// Name, used for output files.
@@ -54,7 +55,7 @@ fn default_materials() -> Vec<Material> {
     vec![Material::default()]
 }
 
-#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Domain {
     /// `[x_min, x_max]` of the periodic cell, m. Default: not periodic.
@@ -63,7 +64,7 @@ pub struct Domain {
 }
 
 /// Where the grains come from.
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case", deny_unknown_fields)]
 pub enum Grains {
     /// Grains listed one by one.
@@ -83,7 +84,7 @@ pub enum Grains {
 }
 
 /// The columns of a grain file.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
 pub enum GrainColumns {
     /// Centre x, y and radius, m.
     #[default]
@@ -111,7 +112,7 @@ impl GrainColumns {
     }
 }
 
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct GrainSpec {
     /// Centre, m.
@@ -129,7 +130,7 @@ pub struct GrainSpec {
     pub material: usize,
 }
 
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct PackSpec {
     /// Number of grains.
@@ -159,7 +160,7 @@ fn default_fraction() -> f64 {
     0.75
 }
 
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct WallsSpec {
     pub bottom: WallSpec,
@@ -170,7 +171,7 @@ pub struct WallsSpec {
     pub thickness: Option<f64>,
 }
 
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct WallSpec {
     /// Position of the contact plane (flat) or of the glued grains' centres (rough), m.
@@ -195,7 +196,7 @@ pub struct WallSpec {
     pub material: usize,
 }
 
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case", deny_unknown_fields)]
 pub enum SurfaceSpec {
     #[default]
@@ -204,7 +205,7 @@ pub enum SurfaceSpec {
     Rough { radius: f64 },
 }
 
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case", deny_unknown_fields)]
 pub enum ControlSpec {
     #[default]
@@ -214,7 +215,7 @@ pub enum ControlSpec {
 }
 
 /// Tangential formulation.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum TangentialSpec {
     /// LIGGGHTS `tangential history`.
@@ -226,7 +227,7 @@ pub enum TangentialSpec {
     Frictionless,
 }
 
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ModelSpec {
     #[serde(default)]
@@ -258,7 +259,7 @@ impl Default for ModelSpec {
 }
 
 /// How the time step is chosen.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case", deny_unknown_fields)]
 pub enum TimeStepRule {
     /// A given dt, s.
@@ -276,7 +277,7 @@ pub enum TimeStepRule {
     Accuracy { quantity: crate::accuracy::AccuracyQuantity, tolerance: f64, impact_speed: f64 },
 }
 
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct TimeStepSpec {
     pub rule: TimeStepRule,
@@ -289,7 +290,7 @@ pub struct TimeStepSpec {
     pub allow_unstable: bool,
 }
 
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct NeighborSpec {
     /// Verlet skin as a fraction of the smallest grain diameter, > 0. Default 0.2.
@@ -307,7 +308,7 @@ impl Default for NeighborSpec {
     }
 }
 
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct OutputSpec {
     /// Rows of the time series (energy, walls). Default 200.
@@ -335,7 +336,7 @@ impl Default for OutputSpec {
 }
 
 /// What the summary reports.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum Analysis {
     #[default]

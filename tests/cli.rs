@@ -165,3 +165,142 @@ fn thread_counts_this_build_cannot_give_are_refused_with_the_range() {
         assert!(err.contains("--threads") && err.contains(allowed), "{args:?}: {err}");
     }
 }
+
+/// Write `scene` to a file in `dir` and export it to `code` into `dir/out`.
+fn export_json(dir: &std::path::Path, code: &str, scene: &Value) -> assert_cmd::assert::Assert {
+    let file = dir.join(format!("{code}.json"));
+    std::fs::write(&file, serde_json::to_string(scene).unwrap()).unwrap();
+    let out = dir.join(format!("out-{code}"));
+    // The same folder serves several exports in a test: each replaces the last.
+    grainlab().args(["export", code, file.to_str().unwrap(), "--out", out.to_str().unwrap(), "--overwrite"]).assert()
+}
+
+fn deck_of(dir: &std::path::Path, code: &str, scene: &Value) -> String {
+    export_json(dir, code, scene).success();
+    std::fs::read_to_string(dir.join(format!("out-{code}")).join(if code == "yade" { "yade.py" } else { "in.liggghts" })).unwrap()
+}
+
+#[test]
+fn export_refuses_general_damping_by_name() {
+    // The engine drags every free grain (F = -c m v, M = -c I w); neither LIGGGHTS'
+    // `fix viscous` (one gamma per type, no torque) nor YADE's damping (Cundall's, not
+    // viscous) is that drag. The deck used to come out as the undamped one.
+    let mut s = builtin_json("collision");
+    s["model"]["general_damping"] = 0.1.into();
+    let dir = tempfile::tempdir().unwrap();
+    for code in ["liggghts", "yade"] {
+        export_json(dir.path(), code, &s).failure().stderr(predicate::str::contains(format!("export to {code}: model.general_damping = 0.1 cannot be expressed")));
+        assert!(!dir.path().join(format!("out-{code}")).exists());
+    }
+}
+
+#[test]
+fn export_to_yade_blocks_spin_without_rotation() {
+    // model.rotation = false: the free grains must not spin in YADE either (the script
+    // used to be byte-identical to the rotating one).
+    let dir = tempfile::tempdir().unwrap();
+    let mut s = builtin_json("oblique");
+    let spinning = deck_of(dir.path(), "yade", &s);
+    s["model"]["rotation"] = false.into();
+    let fixed = deck_of(dir.path(), "yade", &s);
+    assert!(!spinning.contains("'zXYZ'") && fixed.contains("O.bodies[i].state.blockedDOFs = 'zXYZ'"), "{fixed}");
+    let liggghts = deck_of(dir.path(), "liggghts", &s);
+    assert!(liggghts.contains("fix integrate free nve\n"), "{liggghts}");
+}
+
+#[test]
+fn export_writes_or_refuses_the_loaded_walls_mass() {
+    // The shear cell's loaded top wall with twice its glued grains' mass: YADE sets the
+    // clump's mass; LIGGGHTS moves the row as its atoms and refuses by name. Both decks
+    // used to be the default-mass ones.
+    let mut s = builtin_json("shear");
+    s["grains"]["pack"]["count"] = 60.into();
+    s["grains"]["pack"]["x"] = serde_json::json!([0.0, 0.004]);
+    s["domain"]["periodic_x"] = serde_json::json!([0.0, 0.004]);
+    let dir = tempfile::tempdir().unwrap();
+    let default = deck_of(dir.path(), "yade", &s);
+    // Four glued grains of radius 0.5 mm (L = 4 mm): 4 x 4/3 pi r^3 x 2500 kg/m^3.
+    let glued = 4.0 * 4.0 / 3.0 * std::f64::consts::PI * 0.5e-3f64.powi(3) * 2500.0;
+    s["walls"]["top"]["mass"] = (2.0 * glued).into();
+    let heavy = deck_of(dir.path(), "yade", &s);
+    assert!(!default.contains("c.mass"), "{default}");
+    // The mass as the scene gives it (to the last bits serde_json's parser keeps).
+    let line = heavy.lines().find_map(|l| l.strip_prefix("c.mass = ")).unwrap_or_else(|| panic!("no clump mass:\n{heavy}"));
+    let m: f64 = line.split_whitespace().next().unwrap().parse().unwrap();
+    assert!((m / (2.0 * glued) - 1.0).abs() < 1e-15 && line.ends_with("# walls.top.mass, kg"), "{line}");
+    export_json(dir.path(), "liggghts", &s).failure().stderr(predicate::str::contains("export to liggghts: walls.top.mass = ").and(predicate::str::contains("cannot be expressed")));
+}
+
+#[test]
+fn export_notes_where_the_kinematics_differ() {
+    // The seed's lever arm r: LIGGGHTS uses r - dn/2, YADE its own ScGeom kinematics; both
+    // decks say so, naming the field. (The YADE script used to say nothing.)
+    let dir = tempfile::tempdir().unwrap();
+    let s = builtin_json("oblique");
+    for code in ["liggghts", "yade"] {
+        let deck = deck_of(dir.path(), code, &s);
+        assert!(deck.lines().any(|l| l.starts_with("# Differs: model.lever_arm = radius: ")), "{code}:\n{deck}");
+    }
+}
+
+/// Names that run code when a deck pastes them into a comment as they are.
+const HOSTILE: [&str; 2] = ["x\nimport os; os.system('touch PWNED') #", "x\nshell touch PWNED #"];
+
+#[test]
+fn a_scene_name_adds_no_line_to_a_deck() {
+    // A line break in the name ended the comment: the rest was a YADE statement or a
+    // LIGGGHTS command (`shell` runs a program). Each deck and grains.data must have as
+    // many lines as with a plain name, and no line may begin with the payload.
+    let dir = tempfile::tempdir().unwrap();
+    let mut s = builtin_json("collision");
+    for code in ["liggghts", "yade"] {
+        s["name"] = "x".into();
+        let plain = deck_of(dir.path(), code, &s);
+        let plain_data = std::fs::read_to_string(dir.path().join(format!("out-{code}/grains.data"))).unwrap();
+        for name in HOSTILE {
+            s["name"] = name.into();
+            let deck = deck_of(dir.path(), code, &s);
+            let data = std::fs::read_to_string(dir.path().join(format!("out-{code}/grains.data"))).unwrap();
+            assert_eq!(deck.lines().count(), plain.lines().count(), "{code} {name:?}:\n{deck}");
+            assert_eq!(data.lines().count(), plain_data.lines().count(), "{code} {name:?}: grains.data");
+            assert!(!deck.lines().any(|l| l.starts_with("import os") || l.starts_with("shell")), "{code}:\n{deck}");
+        }
+    }
+}
+
+/// Run the reference codes on decks exported from scenes with hostile names: nothing may
+/// create the file, and each deck must still run. Needs `liggghts` and `yade` on PATH
+/// (scripts/setup-reference-tools): `cargo test --test cli -- --ignored hostile`.
+#[test]
+#[ignore]
+fn hostile_names_run_nothing_in_liggghts_and_yade() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut s = builtin_json("collision");
+    for name in HOSTILE {
+        s["name"] = name.into();
+        for (code, program, args) in [("liggghts", "liggghts", vec!["-in", "in.liggghts"]), ("yade", "yade", vec!["-j1", "-n", "-x", "yade.py"])] {
+            export_json(dir.path(), code, &s).success();
+            let run_dir = dir.path().join(format!("out-{code}"));
+            let out = std::process::Command::new(program).args(&args).current_dir(&run_dir).env("OMP_NUM_THREADS", "1").output().expect("the reference code is on PATH");
+            assert!(!run_dir.join("PWNED").exists(), "{code} ran the name {name:?}");
+            assert!(out.status.success(), "{code} failed on the deck of {name:?}:\n{}", String::from_utf8_lossy(&out.stderr));
+            assert!(run_dir.join("series.txt").exists(), "{code} wrote no series.txt");
+            std::fs::remove_dir_all(&run_dir).unwrap();
+        }
+    }
+}
+
+#[test]
+fn export_lists_what_a_code_cannot_express() {
+    // --explain-fields prints the table of one code, what it refuses first, and writes nothing.
+    for (code, refused) in [("liggghts", "walls.top.mass:"), ("yade", "materials[].restitution:")] {
+        let out = grainlab().args(["export", code, "--explain-fields"]).output().unwrap();
+        assert!(out.status.success());
+        let text = String::from_utf8(out.stdout).unwrap();
+        let cannot = text.split("expressed approximately").next().unwrap();
+        assert!(cannot.contains("cannot be expressed") && cannot.contains("  model.general_damping:") && cannot.contains(refused), "{code}:\n{text}");
+        for f in grainlab::export::fields::FIELDS {
+            assert!(text.contains(&format!("  {}", f.path)), "{code}: {} missing", f.path);
+        }
+    }
+}

@@ -3,6 +3,7 @@
 
 use std::marker::PhantomData;
 
+use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 use nalgebra::Vector2;
@@ -17,7 +18,7 @@ use crate::observe::energy::EnergyLedger;
 
 /// Which distance from the grain centre the tangential force acts at (torque lever arm,
 /// and the same arm in the contact-point velocity so that work and torque agree).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, JsonSchema, Default)]
 #[serde(rename_all = "snake_case")]
 pub enum LeverArm {
     /// The grain radius a_i = r_i (the seed).

@@ -7,10 +7,15 @@
 //! The traps of reference-notes.md are handled here: `hard_particles yes`, `atom_modify
 //! map array`, `communicate single vel yes`, `newton off`, `neigh_modify delay 0`,
 //! per-type material matrices that include wall types, `aveforce` per atom.
+//!
+//! The scene name enters comments only, escaped ([`comment`]). What the deck cannot
+//! express is refused and what it expresses approximately is noted, both as
+//! [`super::fields`] says.
 
 use std::fmt::Write as _;
 
-use super::{Exported, f};
+use super::fields::{differs_line, refuse};
+use super::{Code, Exported, escaped, f};
 use crate::contact::LeverArm;
 use crate::error::Error;
 use crate::material::PairMaterial;
@@ -26,15 +31,20 @@ pub(crate) fn deck(scene: &Scene, ex: &Exported) -> Result<String, Error> {
     let n = mats.len();
     let mut s = String::new();
     let w = &mut s;
-    let _ = writeln!(w, "# LIGGGHTS 3.8.0 deck exported by grainlab {} from scene `{}`. Generated: do not edit;", env!("CARGO_PKG_VERSION"), scene.name);
+    let _ = writeln!(w, "# LIGGGHTS 3.8.0 deck exported by grainlab {} from scene `{}`. Generated: do not edit;", env!("CARGO_PKG_VERSION"), comment(&scene.name));
     let _ = writeln!(w, "# regenerate with `grainlab export liggghts SCENE --out DIR`.");
-    let _ = writeln!(w, "# Run in this directory: liggghts -in in.liggghts (reads grains.data, writes {}).", if info.analysis == Analysis::Impact { "series.txt" } else { "walls.txt" });
+    let writes = match info.analysis {
+        Analysis::Impact => "writes series.txt",
+        Analysis::Shear => "writes walls.txt",
+        Analysis::None => "records nothing",
+    };
+    let _ = writeln!(w, "# Run in this directory: liggghts -in in.liggghts (reads grains.data, {writes}).");
     let _ = writeln!(w, "# Grains: spheres at z = 0 in a 3D box (the sphere-in-plane model); nothing moves them out of the plane.");
-    if model.lever_arm == LeverArm::Radius && model.tangential != TangentialSpec::Frictionless {
-        let _ = writeln!(w, "# Differs: LIGGGHTS' torque lever arm is r - dn/2, the scene's is r (model.lever_arm = radius): torques differ by O(dn/r).");
+    if model.lever_arm != LeverArm::RadiusMinusHalfOverlap && model.tangential != TangentialSpec::Frictionless {
+        let _ = writeln!(w, "{}", differs_line(Code::Liggghts, "model.lever_arm", name_of(&model.lever_arm)));
     }
     if model.tangential == TangentialSpec::IncrementalForce {
-        let _ = writeln!(w, "# Differs: the scene's tangential model is incremental (YADE); LIGGGHTS' is total displacement. Only head-on impacts agree.");
+        let _ = writeln!(w, "{}", differs_line(Code::Liggghts, "model.tangential", name_of(&model.tangential)));
     }
     if model.tangential == TangentialSpec::Frictionless {
         let _ = writeln!(w, "# Frictionless: tangential history with coefficientFriction 0, so Ft = 0.");
@@ -83,6 +93,12 @@ pub(crate) fn deck(scene: &Scene, ex: &Exported) -> Result<String, Error> {
                         wall_vars.push((name, format!("f_f_{name}[1]"), format!("f_f_{name}[2]"), a));
                     }
                     Control::Load { force } => {
+                        // The row moves as its atoms: its mass is theirs (equal atoms, so
+                        // aveforce's equal forces keep it rigid).
+                        let atoms: f64 = grains.clone().map(|k| p.m[k]).sum();
+                        if (wall.mass - atoms).abs() > 1e-12 * atoms {
+                            return Err(refuse(Code::Liggghts, &format!("walls.{name}.mass"), wall.mass, &format!("the row's {} atoms weigh {atoms:e} kg", grains.len())));
+                        }
                         let _ = writeln!(w, "fix f_{name} {name} setforce 0.0 NULL 0.0");
                         let _ = writeln!(w, "# the load {} N on the row, per atom (aveforce adds its value to each atom)", f(force));
                         let _ = writeln!(w, "fix l_{name} {name} aveforce NULL {} NULL", f(wall.load_y() / (b + 1 - a) as f64));
@@ -120,12 +136,29 @@ pub(crate) fn deck(scene: &Scene, ex: &Exported) -> Result<String, Error> {
             let _ = writeln!(w, "fix rec all print {k} \"{}\" file walls.txt screen no title \"{}\"", cols.join(" "), info.columns.join(" "));
         }
         Analysis::None => {
-            let _ = writeln!(w, "# timing deck: nothing recorded");
+            let _ = writeln!(w, "{}", if ex.bench { "# timing deck: nothing recorded" } else { "# analysis none: nothing recorded" });
         }
     }
     let _ = writeln!(w, "thermo_style custom step atoms\nthermo {}", (info.steps / 10).max(1));
     let _ = writeln!(w, "run {}", info.steps);
     Ok(s)
+}
+
+/// The scene name in a deck comment: [`escaped`], and `&` escaped too. LIGGGHTS reads a
+/// line ending in `&` (spaces aside) as continued by the next one before it strips the
+/// `#` comment (LIGGGHTS-PUBLIC src/input.cpp, `Input::file`), so a comment ending in `&`
+/// would swallow the next command. `$` and quotes need nothing: the comment is stripped
+/// before variables are substituted, and a `#` outside quotes starts it.
+pub(crate) fn comment(s: &str) -> String {
+    escaped(s, &['&'])
+}
+
+/// The scene's JSON spelling of an enum value (`radius_minus_half_overlap`).
+pub(crate) fn name_of<T: serde::Serialize>(v: &T) -> String {
+    match serde_json::to_value(v) {
+        Ok(serde_json::Value::String(s)) => s,
+        other => format!("{other:?}"),
+    }
 }
 
 /// The LIGGGHTS atom type of a flat wall: its material + 1.

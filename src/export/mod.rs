@@ -12,9 +12,17 @@
 //! Both decks write the same raw output in the working directory: `series.txt` (impact
 //! scenes: the state of grains 1 and 2 at every step) or `walls.txt` (wall scenes: wall
 //! forces averaged over each sample interval). `scripts/regen-reference` turns that into
-//! the reference CSV schema. What each code cannot express is refused with a clear
-//! error, and every approximation is written as a comment at the top of the deck.
+//! the reference CSV schema.
+//!
+//! The exporter is exact or refuses by name: [`fields`] holds, for every scene field and
+//! each code, whether it is written (and where), refused (`export to CODE: PATH = VALUE
+//! cannot be expressed: WHY`), expressed approximately (a `# Differs: PATH = VALUE: ...`
+//! line at the top of the deck) or not part of the physics a deck computes;
+//! tests/export_fields.rs walks the scene's schema and holds the exporter to that table.
+//! The scene name, the one string a deck carries, is escaped for each target
+//! ([`escaped`]).
 
+pub mod fields;
 pub mod liggghts;
 pub mod yade;
 
@@ -26,7 +34,7 @@ use serde::Serialize;
 use crate::build::{Built, build};
 use crate::dim::GrainShape;
 use crate::error::Error;
-use crate::scene::{Analysis, Scene};
+use crate::scene::{Analysis, ControlSpec, Grains, Scene, TangentialSpec};
 use crate::walls::{Control, Surface};
 
 /// The reference codes.
@@ -102,38 +110,43 @@ pub(crate) struct Exported {
 }
 
 pub(crate) fn prepare(scene: &Scene, code: Code) -> Result<Exported, Error> {
-    let unsupported = |what: &str| Err(Error::Other(format!("export to {}: {what}", code.name())));
-    if scene.grain_shape != GrainShape::SphereInPlane {
-        return unsupported("only grain_shape sphere_in_plane is exported (LIGGGHTS `dimension 2` disks are a different model)");
+    if let GrainShape::Disk { thickness } = scene.grain_shape {
+        return Err(fields::refuse(code, "grain_shape.disk.thickness", thickness, ""));
     }
-    if scene.gravity != [0.0, 0.0] {
-        return unsupported("gravity is not exported yet");
+    if let [gx, gy] = scene.gravity
+        && (gx != 0.0 || gy != 0.0)
+    {
+        return Err(fields::refuse(code, "gravity", format!("[{gx}, {gy}]"), ""));
+    }
+    if let Some(c) = scene.model.general_damping {
+        return Err(fields::refuse(code, "model.general_damping", c, ""));
+    }
+    if !scene.model.rotation
+        && scene.model.tangential != TangentialSpec::Frictionless
+        && let Grains::List(list) = &scene.grains
+        && let Some((k, g)) = list.iter().enumerate().find(|(_, g)| g.omega != 0.0)
+    {
+        return Err(fields::refuse(code, &format!("grains.list[{k}].omega"), g.omega, "model.rotation = false"));
     }
     let built = build(scene)?;
     let (steps, sample_every) = crate::run::schedule(scene.duration, built.time_step.dt_s, scene.output.samples);
     let e = built.engine.as_ref();
     let n_free = e.particles().n_free;
     let walls = e.walls();
-    if walls.iter().any(|w| w.is_flat() && w.control != Control::Fixed) {
-        return unsupported("a flat wall under a load has no primitive-wall equivalent; use a rough wall");
-    }
-    if walls.iter().any(|w| !w.is_flat() && w.name == "bottom" && w.control != Control::Fixed) {
-        return unsupported("only the top wall may carry a load");
+    if let Some(w) = walls.iter().find(|w| w.is_flat() && w.control != Control::Fixed) {
+        return Err(fields::refuse(code, &format!("walls.{}.control.pressure", w.name), pressure(scene, w.name), &format!("walls.{}.surface = flat", w.name)));
     }
     let columns = match scene.analysis {
-        Analysis::Impact => {
-            if n_free > 2 || (n_free == 1 && !walls.iter().any(|w| w.is_flat())) {
-                return unsupported("an impact scene has two grains, or one grain and a flat wall");
-            }
-            impact_columns(n_free == 2)
-        }
+        // The build refused an impact without two grains, or a grain and a flat wall.
+        Analysis::Impact => impact_columns(n_free == 2),
         Analysis::Shear => {
-            if walls.iter().any(|w| w.is_flat()) {
-                return unsupported("the shear export needs rough walls");
+            if let Some(w) = walls.iter().find(|w| w.is_flat()) {
+                return Err(fields::refuse(code, &format!("walls.{}.surface", w.name), "flat", "analysis = shear"));
             }
             wall_columns()
         }
-        Analysis::None => return unsupported("only impact and shear scenes are exported (set `analysis`)"),
+        // The deck records nothing, as a timing deck.
+        Analysis::None => Vec::new(),
     };
     let p = e.particles();
     let impact = scene.analysis == Analysis::Impact;
@@ -154,11 +167,39 @@ pub(crate) fn prepare(scene: &Scene, code: Code) -> Result<Exported, Error> {
     Ok(Exported { built, info, bench: false })
 }
 
+/// The pressure a scene puts on wall `name` (`walls.NAME.control.pressure`), Pa; 0 if held.
+pub(crate) fn pressure(scene: &Scene, name: &str) -> f64 {
+    let w = scene.walls.as_ref().expect("a wall exists");
+    match if name == "bottom" { &w.bottom.control } else { &w.top.control } {
+        ControlSpec::Pressure(p) => *p,
+        ControlSpec::Fixed => 0.0,
+    }
+}
+
+/// `s` as printable ASCII on one line: `\`, quotes, control and non-ASCII characters as
+/// Rust escapes (`\n`, `\u{e9}`), and each of `also` as `\u{..}`. This is how the
+/// scene name enters the decks' comments and the title line of grains.data: no line
+/// break can start a command (LIGGGHTS) or a statement (Python), and nothing outside
+/// printable ASCII reaches a reader that assumes an encoding.
+pub fn escaped(s: &str, also: &[char]) -> String {
+    let mut out = String::with_capacity(s.len());
+    for c in s.chars() {
+        if also.contains(&c) {
+            let _ = write!(out, "\\u{{{:x}}}", c as u32);
+        } else {
+            out.extend(c.escape_default());
+        }
+    }
+    out
+}
+
 /// The shared particle file, LAMMPS data format for `atom_style granular`.
 pub(crate) fn grains_data(scene: &Scene, built: &Built, bounds: [[f64; 2]; 3]) -> String {
     let p = built.engine.particles();
     let mut s = String::new();
-    let _ = writeln!(s, "grainlab grains of scene `{}`: id type diameter(m) density(kg/m^3) x y z (m); velocities: id vx vy vz (m/s) wx wy wz (rad/s)", scene.name);
+    // The title line: LIGGGHTS' read_data skips the first line whole, and the YADE script
+    // counts lines from it, so it must stay one line.
+    let _ = writeln!(s, "grainlab grains of scene `{}`: id type diameter(m) density(kg/m^3) x y z (m); velocities: id vx vy vz (m/s) wx wy wz (rad/s)", escaped(&scene.name, &[]));
     let _ = writeln!(s, "\n{} atoms\n{} atom types\n", p.len(), scene.materials.len());
     for (k, ax) in ["x", "y", "z"].iter().enumerate() {
         let _ = writeln!(s, "{:.17e} {:.17e} {ax}lo {ax}hi", bounds[k][0], bounds[k][1]);
@@ -237,6 +278,7 @@ pub fn export_files(scene: &Scene, code: Code, bench: bool) -> Result<Vec<(&'sta
     let data = grains_data(scene, &ex.built, [[b[0][0], b[1][0]], [b[0][1], b[1][1]], [b[0][2], b[1][2]]]);
     Ok(vec![(code.deck(), deck), ("grains.data", data), ("export.json", serde_json::to_string_pretty(&ex.info).expect("serialisable") + "\n")])
 }
+
 
 /// Format a float so that it reads back to the same f64.
 pub(crate) fn f(v: f64) -> String {

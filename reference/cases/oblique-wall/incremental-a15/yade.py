@@ -2,6 +2,8 @@
 # regenerate with `grainlab export yade SCENE --out DIR`.
 # Run in this directory: yade -n -x yade.py (reads grains.data, writes series.txt).
 # Recorded between the contact law and the integrator: positions x(n), force F(x(n)), velocities v(n-1/2).
+# Differs: walls.bottom.surface = flat: YADE's hertzian wall has a large finite radius, so R* and the ratcheting factor differ from a plane's by O(r / R_wall) (2e-9 relative on the oblique impacts)
+# Differs: walls.top.surface = flat: YADE's hertzian wall has a large finite radius, so R* and the ratcheting factor differ from a plane's by O(r / R_wall) (2e-9 relative on the oblique impacts)
 import math, sys
 E = [6.30000000000000000e10]
 NU = [2.00000000000000011e-1]

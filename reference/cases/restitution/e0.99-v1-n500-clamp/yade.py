@@ -2,7 +2,8 @@
 # regenerate with `grainlab export yade SCENE --out DIR`.
 # Run in this directory: yade -n -x yade.py (reads grains.data, writes series.txt).
 # Recorded between the contact law and the integrator: positions x(n), force F(x(n)), velocities v(n-1/2).
-# Differs: the scene's tangential model is total displacement (LIGGGHTS); YADE's is incremental. Only head-on impacts agree.
+# Differs: model.tangential = total_displacement: YADE's Mindlin law adds force increments; head-on impacts agree, oblique ones differ (rebound spin up to 2x)
+# Differs: model.lever_arm = radius_minus_half_overlap: YADE's ScGeom kinematics are lever_arm yade (full radii for the spins in the contact velocity, its translational part scaled by (r1 + r2) / (r1 + r2 - dn), torque arm r - dn/2, r - dn on a wall); torques and tangential velocities differ by O(dn/r)
 import math, sys
 E = [6.30000000000000000e10]
 NU = [2.00000000000000011e-1]

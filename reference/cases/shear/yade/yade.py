@@ -2,6 +2,7 @@
 # regenerate with `grainlab export yade SCENE --out DIR`.
 # Run in this directory: yade -n -x yade.py (reads grains.data, writes series.txt).
 # Recorded between the contact law and the integrator: positions x(n), force F(x(n)), velocities v(n-1/2).
+# Differs: walls.top.control.pressure = 100000: YADE's leapfrog takes the initial velocities as v(-1/2), grainlab's velocity Verlet as v(0): bodies under a force at t = 0 (the loaded wall, touching grains) start O(a dt^2) apart, which a flow forgets
 import math, sys
 E = [6.30000000000000000e10]
 NU = [2.00000000000000011e-1]
