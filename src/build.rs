@@ -286,6 +286,12 @@ pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<B
                 let allowed = format!(">= about {need} (to fill x = [{}, {}] m at packing_fraction {} at least one grain diameter high)", spec.x[0], spec.x[1], spec.packing_fraction);
                 return Err(Error::Invalid { field: "grains.pack.count".into(), value: spec.count.to_string(), allowed });
             }
+            // The region at least a grain wide (two, over a periodic cell: a grain must not
+            // meet its own image), and its top within the coordinates' bound.
+            let periodic = boundary.is_periodic() && spec.x[0] == boundary.x_min && spec.x[1] == boundary.x_min + boundary.period;
+            let widest = if periodic { 4.0 * r_max } else { 2.0 * r_max };
+            crate::error::check(lx >= widest, "grains.pack", "x", format!("[{}, {}]", spec.x[0].shown(), spec.x[1].shown()), &format!("a region at least {} m wide ({} the largest radius drawn, {} m)", widest.shown(), if periodic { "four times" } else { "twice" }, r_max.shown()))?;
+            crate::error::check(coordinate_ok(y0 + h), "grains.pack", "count", spec.count, &format!("a packing whose top (y = {} m, from the count, radii and packing_fraction) lies within {bound:e} m of the origin", (y0 + h).shown()))?;
             // The region must fit under a top wall placed by the scene.
             if let Some(ws) = &scene.walls
                 && let Some(t) = ws.top.y {
@@ -300,7 +306,6 @@ pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<B
                 }
             // Periodic over the cell when the region is the cell (the packing then wraps);
             // a narrower region is packed between its ends.
-            let periodic = boundary.is_periodic() && spec.x[0] == boundary.x_min && spec.x[1] == boundary.x_min + boundary.period;
             let centres = relaxed_packing(&radii, spec.x[0], spec.x[1], y0, y0 + h, periodic, spec.seed);
             // A packing's order is arbitrary: store it along a space-filling curve.
             for k in crate::pack::morton_order(&centres, spec.x[0], y0, 2.0 * r_max) {
@@ -370,8 +375,14 @@ pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<B
     consistency::masses(&p, &names, &walls, mats)?;
     consistency::periodic_cell(&boundary, &p)?;
     consistency::start_overlaps(&p, &walls, &boundary, &names, if packed { MAX_PACKING_OVERLAP } else { MAX_START_OVERLAP }, scene)?;
-    let start_overlap = crate::neighbor::largest_overlap(&p.x, &p.r, n_free, &boundary, f64::INFINITY)
-        .map(|(i, j, ratio)| (ratio, format!("{} and {}", names.name(i, &p, &walls), names.name(j, &p, &walls))));
+    // The largest overlap at the start, and the speed its stored energy would throw two
+    // grains apart at: sqrt(E*/rho) (dn/r)^(5/4) (Hertz: the speed of an impact that
+    // presses a contact in that far).
+    let start_overlap = crate::neighbor::largest_overlap(&p.x, &p.r, n_free, &boundary, f64::INFINITY).map(|(i, j, ratio)| {
+        let (a, b) = (&mats[p.material[i] as usize], &mats[p.material[j] as usize]);
+        let release = (PairMaterial::mix(a, b).e_star / a.density.min(b.density)).sqrt() * ratio.powf(1.25);
+        (ratio, format!("{} and {}", names.name(i, &p, &walls), names.name(j, &p, &walls)), release)
+    });
 
     // Time step from the smallest grain.
     let friction = scene.model.tangential != TangentialSpec::Frictionless;
@@ -406,8 +417,10 @@ pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<B
     };
     estimate.rows = (rows as u64, field, value);
     limits.check(&estimate)?;
-    consistency::motion(&p, &walls, &names, dt)?;
+    consistency::motion(&p, &walls, Vec2::from(scene.gravity), &names, dt)?;
     consistency::load(scene, &p, &walls, length, depth, dt)?;
+    consistency::stable_for_every_pair(scene, &p, &walls, &time_step)?;
+    consistency::drag(scene, dt)?;
     consistency::impact(scene, &p, &walls, &boundary, scene.duration)?;
 
     let r_min = p.r[..n_free].iter().cloned().fold(f64::INFINITY, f64::min);
@@ -416,6 +429,7 @@ pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<B
     let start_speed = (0..n_free).map(|k| p.v[k].norm()).chain(walls.iter().map(|w| w.v.norm())).fold(0.0, f64::max);
     let context = Context {
         start_overlap,
+        characteristic_speed: time_step.characteristic_speed_m_s,
         contact_time: time_step.contact_time_s,
         stability_limit: time_step.stability_limit_s,
         allow_unstable: ts.allow_unstable,

@@ -184,8 +184,8 @@ pub fn start_overlaps(p: &Particles, walls: &[Wall], boundary: &Boundary, names:
 }
 
 /// No grain, grain surface or wall moving more than [`MAX_STEP_MOVE`] of the smallest
-/// radius in one step of `dt`.
-pub fn motion(p: &Particles, walls: &[Wall], names: &GrainNames, dt: f64) -> Result<(), Error> {
+/// radius in one step of `dt`, nor gravity adding that much to a move in one step.
+pub fn motion(p: &Particles, walls: &[Wall], gravity: Vec2, names: &GrainNames, dt: f64) -> Result<(), Error> {
     let r_min = p.r[..p.n_free].iter().cloned().fold(f64::INFINITY, f64::min);
     let most = MAX_STEP_MOVE * r_min;
     let allowed = |what: &str, now: f64| {
@@ -207,6 +207,78 @@ pub fn motion(p: &Particles, walls: &[Wall], names: &GrainNames, dt: f64) -> Res
         let step = w.v.norm() * dt;
         if !(step <= most) {
             return Err(refuse(format!("walls.{}.velocity_x", w.name), w.v.x.shown(), allowed("a wall speed", step)));
+        }
+    }
+    // What gravity adds to a grain's move in one step.
+    let step = gravity.norm() * dt * dt;
+    if !(step <= most) {
+        return Err(refuse("gravity", format!("[{}, {}] m/s^2", gravity.x.shown(), gravity.y.shown()), allowed("a gravity that adds", step)));
+    }
+    Ok(())
+}
+
+/// The time step must be stable for every pair of materials the scene's grains and flat
+/// walls use, not only for the smallest grain's own material (which sets dt): each pair
+/// at the smallest radius, each grain of its own material's mass. Without
+/// `time_step.allow_unstable`, dt above the stiffest pair's limit is refused.
+pub fn stable_for_every_pair(scene: &Scene, p: &Particles, walls: &[Wall], info: &crate::timestep::TimeStepInfo) -> Result<(), Error> {
+    use crate::timestep::RefContact;
+    if scene.time_step.allow_unstable {
+        return Ok(());
+    }
+    let mats = &scene.materials;
+    let mut used: Vec<usize> = p.material[..p.n_free].iter().map(|&m| m as usize).collect();
+    used.sort_unstable();
+    used.dedup();
+    let r = p.r[..p.n_free].iter().cloned().fold(f64::INFINITY, f64::min);
+    let shape = scene.grain_shape;
+    let grain = |k: usize| {
+        let m = shape.mass(r, mats[k].density);
+        (m, shape.inertia(r, m))
+    };
+    let mut refs = Vec::new();
+    let mut names = Vec::new();
+    for (ia, &a) in used.iter().enumerate() {
+        let (ma, ia_) = grain(a);
+        for &b in &used[ia..] {
+            let (mb, ib) = grain(b);
+            refs.push(RefContact { r_star: r / 2.0, m_star: ma * mb / (ma + mb), pair: PairMaterial::mix(&mats[a], &mats[b]), inv_tangential_mass: 1.0 / ma + 1.0 / mb + r * r / ia_ + r * r / ib });
+            names.push(format!("materials[{a}] against materials[{b}]"));
+        }
+        for w in walls.iter().filter(|w| w.is_flat()) {
+            refs.push(RefContact { r_star: r, m_star: ma, pair: PairMaterial::mix(&mats[a], &mats[w.material]), inv_tangential_mass: 1.0 / ma + r * r / ia_ });
+            names.push(format!("materials[{a}] against the {} wall", w.name));
+        }
+    }
+    let friction = scene.model.tangential != crate::scene::TangentialSpec::Frictionless;
+    let v = info.characteristic_speed_m_s;
+    let limit = |c: &RefContact| crate::timestep::stability_limit(std::slice::from_ref(c), v, friction);
+    let Some(k) = (0..refs.len()).min_by(|&x, &y| limit(&refs[x]).total_cmp(&limit(&refs[y]))) else { return Ok(()) };
+    let worst = limit(&refs[k]);
+    if !(info.dt_s <= worst) {
+        return Err(refuse(
+            "time_step",
+            format!("dt = {:.4e} s", info.dt_s),
+            format!(
+                "<= {worst:.4e} s, the stability limit of the stiffest contact the scene has ({}, at the smallest radius and {v} m/s), not only of the smallest grain's own material: use more steps per contact, or set time_step.allow_unstable",
+                names[k]
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// The general damping's drag `F = -c m v` is explicit: its relaxation time 1/c must be
+/// longer than the time step (c dt <= 1; beyond, each step overshoots, and from c dt = 2
+/// the drag itself is unstable).
+pub fn drag(scene: &Scene, dt: f64) -> Result<(), Error> {
+    if let Some(c) = scene.model.general_damping {
+        if !(c * dt <= 1.0) {
+            return Err(refuse(
+                "model.general_damping",
+                format!("{} 1/s", c.shown()),
+                format!("<= {:.4e} 1/s at dt = {dt:.4e} s: a drag whose relaxation time 1/c is at least a time step (c dt <= 1; the explicit drag overshoots beyond and is unstable from 2)", 1.0 / dt),
+            ));
         }
     }
     Ok(())

@@ -110,9 +110,11 @@ fn surface(w: &Wall) -> f64 {
 /// What the build knew that helps tell why a run went wrong.
 #[derive(Clone, Debug, Default)]
 pub struct Context {
-    /// The largest overlap at the start, as a fraction of the smaller radius, and between
-    /// which grains.
-    pub start_overlap: Option<(f64, String)>,
+    /// The largest overlap at the start, as a fraction of the smaller radius, between
+    /// which grains, and the speed its stored energy would throw them apart at, m/s.
+    pub start_overlap: Option<(f64, String, f64)>,
+    /// The speed the time step was chosen for, m/s.
+    pub characteristic_speed: f64,
     /// Hertz contact time of the reference contact, s.
     pub contact_time: f64,
     /// Stability limit of the time step, s.
@@ -131,13 +133,16 @@ impl Context {
     /// (`grain`, if one is to blame) went wrong.
     #[allow(clippy::too_many_arguments)]
     pub fn likely_cause(&self, p: &Particles, walls: &[Wall], gravity: Vec2, dt: f64, time: f64, grain: Option<usize>, max_step: f64) -> String {
-        // Set-up: grains created overlapping push apart in their first contact times.
-        if let Some((ratio, pair)) = &self.start_overlap
-            && *ratio > 1e-3 && time < 10.0 * self.contact_time {
+        // Set-up: grains created overlapping push apart in their first contact times, at
+        // speeds far above those the time step was chosen for.
+        if let Some((ratio, pair, release)) = &self.start_overlap {
+            if *release > 10.0 * self.characteristic_speed && time < 10.0 * self.contact_time {
                 return format!(
-                    "the scene's grains start overlapping ({pair} overlap by {ratio:.2e} of a radius): the first steps push them apart violently. Start them apart (a lower grains.pack.packing_fraction, or listed grains further apart)"
+                    "the scene's grains start overlapping ({pair} overlap by {ratio:.2e} of a radius, enough to throw them apart at about {release:.3e} m/s, against the {} m/s the time step was chosen for). Start them apart (a lower grains.pack.packing_fraction, or listed grains further apart)",
+                    self.characteristic_speed
                 );
             }
+        }
         // The load: a wall that moves more than a grain may in a step, or whose grain
         // went wrong.
         if let Some(pa) = self.pressure
@@ -151,20 +156,34 @@ impl Context {
                     );
                 }
             }
-        // Gravity with nothing to stop the grains.
-        if gravity != Vec2::zeros() && walls.is_empty()
-            && let Some(g) = grain.filter(|&g| g < p.n_free)
-                && p.v[g].dot(&gravity) > 0.0 && p.v[g].norm() > 2.0 * self.start_speed {
-                    return format!(
-                        "gravity: grain {g} has fallen freely to {:.3e} m/s, and the scene has no wall to stop it. Add walls, or shorten the duration",
-                        p.v[g].norm()
-                    );
-                }
+        // Gravity: a grain falling freely (along gravity, as fast as a free fall since the
+        // start) with nothing to stop it.
+        if let Some(g) = grain.filter(|&g| g < p.n_free) {
+            let falling = p.v[g].dot(&gravity) > 0.0 && p.v[g].norm() >= 0.5 * gravity.norm() * time;
+            if gravity != Vec2::zeros() && falling && p.v[g].norm() > 2.0 * self.start_speed {
+                return format!(
+                    "gravity: grain {g} has fallen freely to {:.3e} m/s ({:?} m/s^2 for {time:.3e} s), and nothing stops it. Add a wall across its path, or shorten the duration",
+                    p.v[g].norm(),
+                    [gravity.x, gravity.y]
+                );
+            }
+        }
         let ratio = dt / self.stability_limit;
         if self.allow_unstable && ratio > 1.0 {
             return format!(
                 "the time step {dt:.3e} s is {ratio:.2} times the stability limit {:.3e} s (time_step.allow_unstable is set). Use more steps per contact",
                 self.stability_limit
+            );
+        }
+        // Grains far faster than the time step was chosen for: their contacts are shorter
+        // than it assumed.
+        let fastest = (0..p.n_free).map(|i| p.v[i].norm()).filter(|v| v.is_finite()).fold(0.0, f64::max);
+        if fastest > 10.0 * self.characteristic_speed {
+            return format!(
+                "grains move at up to {fastest:.3e} m/s, {:.0} times the {} m/s the time step was chosen for: their contacts last far fewer steps than {:.1}. Find what accelerates them (a load, a wall, a material far softer or lighter than intended), or choose the time step for that speed (time_step.characteristic_speed, or the rule's impact_speed)",
+                fastest / self.characteristic_speed,
+                self.characteristic_speed,
+                self.contact_time / dt
             );
         }
         format!(

@@ -214,6 +214,10 @@ impl Grid {
         if fx * fy > max_cells {
             let s = (fx * fy / max_cells).sqrt().ceil();
             (fx, fy) = ((fx / s).floor().max(1.0), (fy / s).floor().max(1.0));
+            // A side that was one cell already takes no share of the cut: the other
+            // takes it all (a tall, narrow region asked for 9e8 rows of one cell).
+            fy = fy.min((max_cells / fx).floor()).max(1.0);
+            fx = fx.min((max_cells / fy).floor()).max(1.0);
         }
         let (mut nx, ny) = (fx as usize, fy as usize);
         // A periodic row of fewer than three cells would meet itself: one cell then.

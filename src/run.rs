@@ -227,11 +227,15 @@ pub fn run_report(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<
     let mut wall_rows: Vec<WallRow> = Vec::new();
     let mut max_res: f64 = 0.0;
     let mut energy_rows = 0usize;
+    // The last row recorded (of a state that passed its checks): the summary's, so that a
+    // run stopped on a state gone wrong reports the last one that was not.
+    let mut last_row: Option<EnergyRow> = None;
     let mut record_energy = |e: &dyn crate::build::Engine, out: &mut Outputs| -> Result<(), Error> {
         if energy_on {
             let row = e.energy_row();
             max_res = max_res.max(row.residual_j.abs() / row.put_in().max(f64::MIN_POSITIVE));
             energy_rows += 1;
+            last_row = Some(row);
             if let Some(w) = out.energy.as_mut() {
                 w.row(&row)?;
             }
@@ -350,7 +354,7 @@ pub fn run_report(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<
         simulated_time_s: e.time(),
         wall_time_s: wall_time,
         particle_steps_per_s: p.n_free as f64 * e.steps() as f64 / wall_time.max(1e-9),
-        energy: energy_on.then(|| energy_summary(e.energy_row(), max_res, dt)),
+        energy: energy_on.then(|| energy_summary(last_row.unwrap_or_else(|| e.energy_row()), max_res, dt)),
         impact: impact.as_ref().and_then(|o| o.summary()),
         shear,
         stage_timing,

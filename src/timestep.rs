@@ -61,6 +61,11 @@ fn limits(refs: &[RefContact], v: f64, friction: bool) -> (f64, f64) {
     (tc, 2.0 / omega)
 }
 
+/// The stability limit 2 / omega_max over the contacts `refs` at speed `v`, s.
+pub fn stability_limit(refs: &[RefContact], v: f64, friction: bool) -> f64 {
+    limits(refs, v, friction).1
+}
+
 /// Apply the rule. `smallest` is the smallest grain's (radius, mass, material).
 pub fn choose(
     rule: &TimeStepRule,
