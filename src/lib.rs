@@ -5,8 +5,12 @@
 //! 1. **Scene** ([`scene`]): a JSON file (or a built-in, [`scenes`]) says what is simulated:
 //!    materials ([`material`]), grains (listed, from a file, or a seeded packing, [`pack`]),
 //!    walls, periodicity, the contact model, the time step rule, outputs. It is
-//!    validated as a whole; errors name the field and the allowed range ([`error`]).
-//! 2. **Build** ([`build`]): the scene becomes a [`sim::World`] (grain state as struct of
+//!    validated as a whole; errors name the field's JSON path, the value and what is
+//!    allowed ([`error`]).
+//! 2. **Build** ([`build`]): every size the scene asks for is estimated and checked
+//!    against a memory budget before it is allocated ([`limits`]), and the grains, walls,
+//!    speeds, load and analysis are checked against each other ([`consistency`]). Then
+//!    the scene becomes a [`sim::World`] (grain state as struct of
 //!    arrays, [`particles`]; the plane and grain shapes, [`dim`]) and a **pipeline**
 //!    ([`pipeline`]) of stages, only those the scene asks for: no walls, no wall stage; no
 //!    gravity, no gravity stage; no friction, no spin. The time step follows a rule and
@@ -25,12 +29,15 @@
 //! 4. **Simulation** ([`sim`]): velocity Verlet ([`integrate`]; on AVX-512 CPUs eight
 //!    grains at a time, module `avx512`; between the steps a run looks at, a step's final
 //!    half kick rides along the next drift, with the same bits) runs the stages each
-//!    step, timed per stage; a watchdog stops a run that goes unstable, with a diagnosis.
+//!    step, timed per stage; a watchdog and the domain's checks at each neighbour rebuild
+//!    ([`domain`]) stop a run that goes wrong, naming the grain, the step and the likely
+//!    cause.
 //!    With the `parallel` feature the per-grain stages and the contact forces run on
 //!    several threads ([`threads`], [`parallel`]), bit for bit the same as on one.
 //! 5. **Observers** ([`observe`]): the energy balance, impact measurements, wall stresses,
 //!    with block-averaged confidence intervals ([`stats`]).
-//! 6. **Output** ([`output`]): `summary.json`, CSV time series with unit-suffixed headers,
+//! 6. **Output** ([`output`]): only finite numbers ([`finite`]; an undefined quantity is
+//!    empty or `null`): `summary.json`, CSV time series with unit-suffixed headers,
 //!    ParaView `.vtp` frames with a `.pvd` index, in an output folder that is grainlab's
 //!    (a manifest of what it wrote, files that appear whole; [`output::folder`]); [`run`]
 //!    drives it all with a progress bar, and ends early on a stop request (SIGINT,
