@@ -126,8 +126,9 @@ fig, axes = plt.subplots(1, len(shear_cases), figsize=(5 * len(shear_cases), 4),
 shear_table = []
 for ax, (case, code) in zip(axes[0], shear_cases):
     out = engine(case)
-    e = rows(os.path.join(out, "walls.csv"))
-    r = expected(case, code, "stress.csv")
+    # tau/sigma is an empty cell where the normal stress is zero: no point there.
+    e = [x for x in rows(os.path.join(out, "walls.csv")) if x["stress_ratio"] != ""]
+    r = [x for x in expected(case, code, "stress.csv") if x["stress_ratio"] != ""]
     ax.plot([float(x["time_s"]) * 1e3 for x in e], [float(x["stress_ratio"]) for x in e], "-", color="k", lw=0.8, label="grainlab")
     ax.plot([float(x["time_s"]) * 1e3 for x in r], [float(x["stress_ratio"]) for x in r], "-", color="C0" if code == "liggghts" else "C3", lw=0.8, alpha=0.8,
             label={"liggghts": "LIGGGHTS 3.8.0", "yade": "YADE 2023.02a"}[code])

@@ -273,7 +273,10 @@ pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<B
             for (field, v) in [("x", spec.x[0]), ("x", spec.x[1]), ("y_min", y0)] {
                 crate::error::check(coordinate_ok(v), "grains.pack", field, v, &format!("within {bound:e} m of the origin ({:e} largest radii)", crate::limits::MAX_COORDINATE_RADII))?;
             }
-            let mass_ok = |r: f64| shape.mass(r, mats[spec.material].density).is_finite() && shape.mass(r, mats[spec.material].density) > 0.0;
+            let mass_ok = |r: f64| {
+                let m = shape.mass(r, mats[spec.material].density);
+                m.is_finite() && m > 0.0
+            };
             crate::error::check(mass_ok(lo) && mass_ok(hi), "grains.pack", "radius", format!("[{lo}, {hi}] m"), "radii whose masses are finite and > 0 at this density")?;
             let radii = spec.radius.sample(spec.count, spec.seed);
             let area: f64 = radii.iter().map(|r| std::f64::consts::PI * r * r).sum();
@@ -283,11 +286,13 @@ pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<B
             // Too few grains to fill the x range one grain high at this packing fraction.
             if !(h >= 2.0 * r_max) {
                 let need = (2.0 * r_max * spec.packing_fraction * lx / (area / spec.count as f64)).ceil();
-                let allowed = format!(">= about {need} (to fill x = [{}, {}] m at packing_fraction {} at least one grain diameter high)", spec.x[0], spec.x[1], spec.packing_fraction);
+                let allowed = format!(">= about {} (to fill x = [{}, {}] m at packing_fraction {} at least one grain diameter high)", need.shown(), spec.x[0].shown(), spec.x[1].shown(), spec.packing_fraction);
                 return Err(Error::Invalid { field: "grains.pack.count".into(), value: spec.count.to_string(), allowed });
             }
-            // The region at least a grain wide (two, over a periodic cell: a grain must not
-            // meet its own image), and its top within the coordinates' bound.
+            // Periodic over the cell when the region is the cell (the packing then wraps);
+            // a narrower region is packed between its ends. The region at least a grain
+            // wide (two, over a periodic cell: a grain must not meet its own image), and its
+            // top within the coordinates' bound.
             let periodic = boundary.is_periodic() && spec.x[0] == boundary.x_min && spec.x[1] == boundary.x_min + boundary.period;
             let widest = if periodic { 4.0 * r_max } else { 2.0 * r_max };
             crate::error::check(lx >= widest, "grains.pack", "x", format!("[{}, {}]", spec.x[0].shown(), spec.x[1].shown()), &format!("a region at least {} m wide ({} the largest radius drawn, {} m)", widest.shown(), if periodic { "four times" } else { "twice" }, r_max.shown()))?;
@@ -304,8 +309,6 @@ pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<B
                         &format!(">= {} m: the packing fills y = [{y0}, {}] m (its count at its packing_fraction), below the top wall's surface", y0 + h + ws.top.surface.radius(), y0 + h),
                     )?;
                 }
-            // Periodic over the cell when the region is the cell (the packing then wraps);
-            // a narrower region is packed between its ends.
             let centres = relaxed_packing(&radii, spec.x[0], spec.x[1], y0, y0 + h, periodic, spec.seed);
             // A packing's order is arbitrary: store it along a space-filling curve.
             for k in crate::pack::morton_order(&centres, spec.x[0], y0, 2.0 * r_max) {
