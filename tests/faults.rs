@@ -150,6 +150,11 @@ fn a_time_step_of_zero_or_infinity_is_refused() {
         let msg = refused("collision", |s| s["materials"][0][field] = json!(value));
         assert_names(&msg, &["time_step = t_c", "finite and > 0"]);
     }
+    // An impact speed at the edge of the range: the contact time it sets is infinite or 0.
+    for speed in [1e-300, 1e300] {
+        let msg = refused("collision", |s| s["time_step"]["rule"]["steps_per_contact"]["impact_speed"] = json!(speed));
+        assert_names(&msg, &["time_step = t_c", "finite and > 0"]);
+    }
     // A step so small that the run would never end.
     let msg = refused("collision", |s| s["time_step"]["rule"] = json!({"fixed": {"dt": 1e-300}}));
     assert_names(&msg, &["duration", "at most 1e12 steps"]);
