@@ -1,8 +1,10 @@
 //! Bad input and faults: every scene the issue found to crash, hang, allocate without
 //! bound, write NaN or run inconsistent is refused before anything is allocated, with its
 //! field, value and what is allowed, or runs to a diagnosed stop with finite outputs.
-//! Each test here failed on the code before the hardening (the panic, the allocation,
-//! the NaN or the silent run it names).
+//! Each test says what the build before the hardening (f706540) did with the same scene,
+//! run as a scene file with its release binary: a panic, an abort, a hang (no end within
+//! 30 s), NaN in a "completed" run's files, a silent run, or a stop whose message did not
+//! name the cause.
 
 use assert_cmd::Command;
 use grainlab::limits::Limits;
@@ -44,6 +46,8 @@ fn assert_names(msg: &str, parts: &[&str]) {
 
 #[test]
 fn an_impact_without_a_pair_or_a_flat_wall_is_refused() {
+    // Old build: panicked in the impact observer (one grain, no wall); ran three grains
+    // to "completed", measuring grains 0 and 1 as if alone.
     // One grain and no wall: the impact observer panicked looking for the wall.
     let msg = refused("oblique", |s| s["walls"] = Value::Null);
     assert_names(&msg, &["analysis = impact", "flat wall"]);
@@ -58,6 +62,7 @@ fn an_impact_without_a_pair_or_a_flat_wall_is_refused() {
 
 #[test]
 fn an_empty_grain_file_is_refused() {
+    // Old build: panicked (build.rs, the smallest grain of none).
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("empty.txt");
     std::fs::write(&path, "# no grains\n\n").unwrap();
@@ -70,18 +75,21 @@ fn an_empty_grain_file_is_refused() {
 
 #[test]
 fn a_pack_count_near_two_to_the_64_is_refused_by_its_memory_estimate() {
+    // Old build: panicked (capacity overflow).
     let msg = refused("shear", |s| s["grains"]["pack"]["count"] = json!(u64::MAX - 5));
     assert_names(&msg, &["grains.pack.count = 18446744073709551610", "memory budget of 1.0 GiB", "EiB for grains"]);
 }
 
 #[test]
 fn a_negative_lognormal_median_is_refused() {
+    // Old build: panicked in the radius sampling.
     let msg = refused("shear", |s| s["grains"]["pack"]["radius"] = json!({"lognormal": {"median": -1e-3, "sigma": 0.2, "min": 4e-4, "max": 6e-4}}));
     assert_names(&msg, &["grains.pack.radius.median = -0.001", "> 0 m"]);
 }
 
 #[test]
 fn pack_ranges_that_overflow_to_infinity_are_refused() {
+    // Old build: refused the first with `count >= about inf`; hung on the second.
     // x_max - x_min overflows to infinity.
     let msg = refused("shear", |s| {
         s["grains"]["pack"]["x"] = json!([-1.7e308, 1.7e308]);
@@ -97,6 +105,7 @@ fn pack_ranges_that_overflow_to_infinity_are_refused() {
 
 #[test]
 fn a_far_away_grain_is_refused_instead_of_sizing_a_grid() {
+    // Old build: aborted allocating 145 GB for the cell grid.
     // The cell grid was sized from the grains' spread: this asked for 145 GB.
     let msg = refused("collision", |s| s["grains"]["list"][1]["x"] = json!([1e300, 0.0]));
     assert_names(&msg, &["grains.list[1] = at (1e300, 0) m", "within 1e3 m of the origin"]);
@@ -104,6 +113,8 @@ fn a_far_away_grain_is_refused_instead_of_sizing_a_grid() {
 
 #[test]
 fn grains_far_apart_within_the_bounds_run_in_memory_proportional_to_their_number() {
+    // Not a defect of the old build (its coarsened grid held this one): the sorted cell
+    // list that replaces the coarsening, at work in a run.
     // 50 grains in a row, and one 500 m away (within 1e6 radii): the grid would have
     // needed 10^11 cells; the sparse cell list needs none. Neighbours still found: grains
     // 0 and 1 touch and push apart.
@@ -126,6 +137,8 @@ fn grains_far_apart_within_the_bounds_run_in_memory_proportional_to_their_number
 
 #[test]
 fn counts_that_would_not_fit_are_refused_with_the_estimate() {
+    // Old build: hung on the tiny rough radius and on the samples (writing NaN rows),
+    // ran the 300 materials (the n^2 table was never bounded).
     // Tiny rough grains: 4e10 wall grains.
     let msg = refused("shear", |s| s["walls"]["bottom"]["surface"] = json!({"rough": {"radius": 5e-13}}));
     assert_names(&msg, &["walls.bottom.surface.rough.radius", "memory budget", "for wall grains"]);
@@ -145,6 +158,9 @@ fn counts_that_would_not_fit_are_refused_with_the_estimate() {
 
 #[test]
 fn a_time_step_of_zero_or_infinity_is_refused() {
+    // Old build: hung at E = 1e300 and dt = 1e-300 and at an impact speed of 1e300,
+    // aborted at 1e-300 m/s; E = 1e-300 and rho = 1e300 were refused as `dt = inf s
+    // is outside <= 3.7e118 s`.
     // Moduli and densities at the edge of the range: a contact time of infinity or 0.
     for (field, value) in [("youngs_modulus", 1e-300), ("youngs_modulus", 1e300), ("density", 1e300)] {
         let msg = refused("collision", |s| s["materials"][0][field] = json!(value));
@@ -162,6 +178,7 @@ fn a_time_step_of_zero_or_infinity_is_refused() {
 
 #[test]
 fn a_grain_file_that_never_ends_is_refused_unread() {
+    // Old build: read /dev/zero until memory ran out (a hang); a folder gave an I/O error.
     for path in ["/dev/zero", "/tmp"] {
         let msg = refused("collision", |s| {
             s["grains"] = json!({"file": {"path": path}});
@@ -175,6 +192,8 @@ fn a_grain_file_that_never_ends_is_refused_unread() {
 
 #[test]
 fn a_huge_spin_or_wall_speed_is_refused_not_run_to_nan() {
+    // Old build: the spin ran to "completed" with 78 NaN rows; the wall speed aborted
+    // allocating 1.1 TB.
     let msg = refused("collision", |s| s["grains"]["list"][1]["omega"] = json!(1e300));
     assert_names(&msg, &["grains.list[1].omega = 1e300 rad/s", "0.05 of the smallest radius"]);
     let msg = refused("shear", |s| s["walls"]["top"]["velocity_x"] = json!(1e300));
@@ -183,6 +202,7 @@ fn a_huge_spin_or_wall_speed_is_refused_not_run_to_nan() {
 
 #[test]
 fn stress_ratio_at_zero_normal_stress_is_an_empty_cell_not_nan() {
+    // Old build: tau/sigma = 0/0 = NaN in every walls.csv row.
     // The built-in oblique impact has walls but no normal stress: tau/sigma = 0/0.
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("out");
@@ -222,6 +242,8 @@ fn a_run_that_goes_unstable_stops_with_a_diagnosis_and_finite_outputs() {
 
 #[test]
 fn a_top_wall_below_the_bottom_wall_is_refused() {
+    // Old build: ran the first to "completed" (276 NaN rows, a negative gap), stopped
+    // the second at step 1 on an overlap, advising a smaller time step.
     let msg = refused("shear", |s| {
         s["walls"]["top"]["y"] = json!(-0.01);
         s["walls"]["top"]["control"] = "fixed".into();
@@ -234,12 +256,14 @@ fn a_top_wall_below_the_bottom_wall_is_refused() {
 
 #[test]
 fn rough_wall_grains_larger_than_the_cell_are_refused() {
+    // Old build: hung.
     let msg = refused("shear", |s| s["walls"]["bottom"]["surface"] = json!({"rough": {"radius": 0.03}}));
     assert_names(&msg, &["walls.bottom.surface.rough.radius = 0.03", "half the periodic cell"]);
 }
 
 #[test]
 fn grains_that_would_tunnel_through_each_other_in_a_step_are_refused() {
+    // Old build: stopped at step 1 on an overlap of 0.126, advising a smaller time step.
     // 4000 m/s at the collision's dt: 1.3e-4 m a step, more than a radius per eight steps.
     let msg = refused("collision", |s| s["grains"]["list"][0]["v"] = json!([4000.0, 0.0]));
     assert_names(&msg, &["grains.list[0].v = [4000, 0] m/s", "0.05 of the smallest radius"]);
@@ -247,6 +271,7 @@ fn grains_that_would_tunnel_through_each_other_in_a_step_are_refused() {
 
 #[test]
 fn an_impact_that_can_never_happen_is_refused() {
+    // Old build: ran both to "completed" with no impact measured.
     // Moving apart.
     let msg = refused("collision", |s| {
         s["grains"]["list"][0]["v"] = json!([-0.5, 0.0]);
@@ -260,6 +285,7 @@ fn an_impact_that_can_never_happen_is_refused() {
 
 #[test]
 fn a_periodic_cell_narrower_than_its_packing_is_refused() {
+    // Old build: stopped at step 1 on an overlap of 2.1 radii, advising a smaller time step.
     let msg = refused("shear", |s| s["domain"]["periodic_x"] = json!([0.0, 0.02]));
     assert_names(&msg, &["grains.pack.x = [0.0, 0.04]", "inside the periodic cell [0, 0.02]"]);
     // A cell shorter than two grain diameters cannot see a grain's two images.
@@ -271,6 +297,7 @@ fn a_periodic_cell_narrower_than_its_packing_is_refused() {
 
 #[test]
 fn a_packing_the_relaxation_cannot_free_of_overlaps_is_refused_with_the_fix() {
+    // Old build: ran to "completed" from overlaps of up to half a radius.
     // Wide lognormal radii at 0.8: the relaxation leaves overlaps of a third of a radius.
     let msg = refused("shear", |s| {
         s["grains"]["pack"]["packing_fraction"] = json!(0.8);
@@ -282,6 +309,7 @@ fn a_packing_the_relaxation_cannot_free_of_overlaps_is_refused_with_the_fix() {
 
 #[test]
 fn listed_grains_created_overlapping_are_refused() {
+    // Old build: stopped at step 1 on the overlap (and on 10.9 radii into the wall).
     let msg = refused("collision", |s| s["grains"]["list"][1]["x"] = json!([0.0005, 0.0]));
     assert_names(&msg, &["grains.list[0]", "grains.list[1] overlaps it by"]);
     // Below the flat bottom wall.
@@ -291,6 +319,7 @@ fn listed_grains_created_overlapping_are_refused() {
 
 #[test]
 fn a_load_the_grains_cannot_carry_or_the_wall_cannot_follow_is_refused() {
+    // Old build: stopped at step 7 and step 1 on overlaps, advising a smaller time step.
     let msg = refused("shear", |s| s["walls"]["top"]["control"] = json!({"pressure": 1e9}));
     assert_names(&msg, &["walls.top.control.pressure = 1000000000 Pa", "at most"]);
     let msg = refused("shear", |s| s["walls"]["top"]["mass"] = json!(1e-12));
@@ -301,6 +330,7 @@ fn a_load_the_grains_cannot_carry_or_the_wall_cannot_follow_is_refused() {
 
 #[test]
 fn a_parse_error_names_the_field_path() {
+    // Old build: `trailing characters at line 1 column 589`.
     let msg = changed("collision", |s| s["gravity"] = json!([0, -9.81, 0])).unwrap_err().to_string();
     assert_names(&msg, &["at `gravity`", "more elements than the field takes"]);
     let msg = changed("collision", |s| s["grains"]["list"][1]["r"] = "big".into()).unwrap_err().to_string();
@@ -309,6 +339,7 @@ fn a_parse_error_names_the_field_path() {
 
 #[test]
 fn a_built_in_name_wins_over_a_folder_of_that_name() {
+    // Old build: read the folder as the scene file (`Is a directory`).
     let dir = tempfile::tempdir().unwrap();
     std::fs::create_dir(dir.path().join("collision")).unwrap();
     Command::cargo_bin("grainlab").unwrap().current_dir(dir.path()).args(["explain", "collision"]).assert().success();
@@ -322,6 +353,8 @@ fn a_built_in_name_wins_over_a_folder_of_that_name() {
 
 #[test]
 fn grain_files_declare_their_columns_and_resolve_against_the_scene_file() {
+    // Old build: read a line of four numbers as x y z r without a word, and looked for
+    // the file in the working directory.
     let dir = tempfile::tempdir().unwrap();
     let sub = dir.path().join("scenes");
     std::fs::create_dir(&sub).unwrap();
@@ -344,6 +377,7 @@ fn grain_files_declare_their_columns_and_resolve_against_the_scene_file() {
 
 #[test]
 fn a_scene_that_fits_the_budget_runs_and_one_that_does_not_names_the_budget_flag() {
+    // New: the budget itself.
     let s = builtin("shear").unwrap();
     let msg = match grainlab::build::build_limited(&s, 1, &Limits::with_memory(1 << 20)) {
         Err(e) => e.to_string(),
