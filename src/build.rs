@@ -299,16 +299,17 @@ pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<B
             crate::error::check(coordinate_ok(y0 + h), "grains.pack", "count", spec.count, &format!("a packing whose top (y = {} m, from the count, radii and packing_fraction) lies within {bound:e} m of the origin", (y0 + h).shown()))?;
             // The region must fit under a top wall placed by the scene.
             if let Some(ws) = &scene.walls
-                && let Some(t) = ws.top.y {
-                    let top_surface = t - ws.top.surface.radius();
-                    crate::error::check(
-                        y0 + h <= top_surface,
-                        "walls.top",
-                        "y",
-                        t,
-                        &format!(">= {} m: the packing fills y = [{y0}, {}] m (its count at its packing_fraction), below the top wall's surface", y0 + h + ws.top.surface.radius(), y0 + h),
-                    )?;
-                }
+                && let Some(t) = ws.top.y
+            {
+                let top_surface = t - ws.top.surface.radius();
+                crate::error::check(
+                    y0 + h <= top_surface,
+                    "walls.top",
+                    "y",
+                    t,
+                    &format!(">= {} m: the packing fills y = [{y0}, {}] m (its count at its packing_fraction), below the top wall's surface", y0 + h + ws.top.surface.radius(), y0 + h),
+                )?;
+            }
             let centres = relaxed_packing(&radii, spec.x[0], spec.x[1], y0, y0 + h, periodic, spec.seed);
             // A packing's order is arbitrary: store it along a space-filling curve.
             for k in crate::pack::morton_order(&centres, spec.x[0], y0, 2.0 * r_max) {

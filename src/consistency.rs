@@ -98,9 +98,10 @@ pub fn coordinates(scene: &Scene, p: &Particles, names: &GrainNames, walls: &[Wa
         return Err(refuse(names.name(i, p, walls), format!("at ({}, {}) m", p.x[i].x.shown(), p.x[i].y.shown()), allowed()));
     }
     if let Some([a, b]) = scene.domain.periodic_x
-        && !(a.abs() <= bound && b.abs() <= bound) {
-            return Err(refuse("domain.periodic_x", format!("[{}, {}]", a.shown(), b.shown()), allowed()));
-        }
+        && !(a.abs() <= bound && b.abs() <= bound)
+    {
+        return Err(refuse("domain.periodic_x", format!("[{}, {}]", a.shown(), b.shown()), allowed()));
+    }
     for w in walls {
         if w.y.abs() > bound {
             return Err(refuse(format!("walls.{}.y", w.name), w.y.shown(), allowed()));
@@ -131,13 +132,14 @@ pub fn periodic_cell(boundary: &Boundary, p: &Particles) -> Result<(), Error> {
         return Err(refuse("domain.periodic_x", format!("[{a}, {b}]"), format!("a cell at least 4 r_max = {} m long (two diameters of the largest grain)", 4.0 * r_max)));
     }
     if boundary.is_periodic()
-        && let Some(i) = (0..p.n_free).find(|&i| !(p.x[i].x >= boundary.x_min && p.x[i].x <= boundary.x_min + boundary.period)) {
-            return Err(refuse(
-                "domain.periodic_x",
-                format!("[{}, {}]", boundary.x_min, boundary.x_min + boundary.period),
-                format!("a periodic cell that holds every grain (grain {i} is at x = {} m)", p.x[i].x),
-            ));
-        }
+        && let Some(i) = (0..p.n_free).find(|&i| !(p.x[i].x >= boundary.x_min && p.x[i].x <= boundary.x_min + boundary.period))
+    {
+        return Err(refuse(
+            "domain.periodic_x",
+            format!("[{}, {}]", boundary.x_min, boundary.x_min + boundary.period),
+            format!("a periodic cell that holds every grain (grain {i} is at x = {} m)", p.x[i].x),
+        ));
+    }
     Ok(())
 }
 
@@ -163,23 +165,25 @@ pub fn start_overlaps(p: &Particles, walls: &[Wall], boundary: &Boundary, names:
         }
     }
     if let Some((i, j, ratio)) = crate::neighbor::largest_overlap(&p.x, &p.r, p.n_free, boundary, bound)
-        && ratio > bound {
-            if let (GrainNames::Pack, Grains::Pack(spec)) = (names, &scene.grains)
-                && i < p.n_free && j < p.n_free {
-                    return Err(refuse(
-                        "grains.pack.packing_fraction",
-                        spec.packing_fraction,
-                        format!(
-                            "a packing the relaxation frees of overlaps: after its 2000 sweeps two grains still overlap by {ratio:.2e} of the smaller radius, more than {bound}. Use a lower packing_fraction (0.7 relaxes fully), or a narrower radius distribution"
-                        ),
-                    ));
-                }
+        && ratio > bound
+    {
+        if let (GrainNames::Pack, Grains::Pack(spec)) = (names, &scene.grains)
+            && i < p.n_free && j < p.n_free
+        {
             return Err(refuse(
-                names.name(i, p, walls),
-                format!("at ({}, {}) m", p.x[i].x.shown(), p.x[i].y.shown()),
-                format!("grains that overlap by at most {bound} of the smaller radius at the start ({} overlaps it by {ratio:.3})", names.name(j, p, walls)),
+                "grains.pack.packing_fraction",
+                spec.packing_fraction,
+                format!(
+                    "a packing the relaxation frees of overlaps: after its 2000 sweeps two grains still overlap by {ratio:.2e} of the smaller radius, more than {bound}. Use a lower packing_fraction (0.7 relaxes fully), or a narrower radius distribution"
+                ),
             ));
         }
+        return Err(refuse(
+            names.name(i, p, walls),
+            format!("at ({}, {}) m", p.x[i].x.shown(), p.x[i].y.shown()),
+            format!("grains that overlap by at most {bound} of the smaller radius at the start ({} overlaps it by {ratio:.3})", names.name(j, p, walls)),
+        ));
+    }
     Ok(())
 }
 
@@ -272,14 +276,14 @@ pub fn stable_for_every_pair(scene: &Scene, p: &Particles, walls: &[Wall], info:
 /// longer than the time step (c dt <= 1; beyond, each step overshoots, and from c dt = 2
 /// the drag itself is unstable).
 pub fn drag(scene: &Scene, dt: f64) -> Result<(), Error> {
-    if let Some(c) = scene.model.general_damping {
-        if !(c * dt <= 1.0) {
-            return Err(refuse(
-                "model.general_damping",
-                format!("{} 1/s", c.shown()),
-                format!("<= {:.4e} 1/s at dt = {dt:.4e} s: a drag whose relaxation time 1/c is at least a time step (c dt <= 1; the explicit drag overshoots beyond and is unstable from 2)", 1.0 / dt),
-            ));
-        }
+    if let Some(c) = scene.model.general_damping
+        && !(c * dt <= 1.0)
+    {
+        return Err(refuse(
+            "model.general_damping",
+            format!("{} 1/s", c.shown()),
+            format!("<= {:.4e} 1/s at dt = {dt:.4e} s: a drag whose relaxation time 1/c is at least a time step (c dt <= 1; the explicit drag overshoots beyond and is unstable from 2)", 1.0 / dt),
+        ));
     }
     Ok(())
 }

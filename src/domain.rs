@@ -135,27 +135,29 @@ impl Context {
     pub fn likely_cause(&self, p: &Particles, walls: &[Wall], gravity: Vec2, dt: f64, time: f64, grain: Option<usize>, max_step: f64) -> String {
         // Set-up: grains created overlapping push apart in their first contact times, at
         // speeds far above those the time step was chosen for.
-        if let Some((ratio, pair, release)) = &self.start_overlap {
-            if *release > 10.0 * self.characteristic_speed && time < 10.0 * self.contact_time {
-                return format!(
-                    "the scene's grains start overlapping ({pair} overlap by {ratio:.2e} of a radius, enough to throw them apart at about {release:.3e} m/s, against the {} m/s the time step was chosen for). Start them apart (a lower grains.pack.packing_fraction, or listed grains further apart)",
-                    self.characteristic_speed
-                );
-            }
+        if let Some((ratio, pair, release)) = &self.start_overlap
+            && *release > 10.0 * self.characteristic_speed
+            && time < 10.0 * self.contact_time
+        {
+            return format!(
+                "the scene's grains start overlapping ({pair} overlap by {ratio:.2e} of a radius, enough to throw them apart at about {release:.3e} m/s, against the {} m/s the time step was chosen for). Start them apart (a lower grains.pack.packing_fraction, or listed grains further apart)",
+                self.characteristic_speed
+            );
         }
         // The load: a wall that moves more than a grain may in a step, or whose grain
         // went wrong.
         if let Some(pa) = self.pressure
-            && let Some(w) = walls.iter().find(|w| matches!(w.control, Control::Load { .. })) {
-                let wall_grain = grain.is_some_and(|g| matches!(&w.surface, crate::walls::Surface::Rough { grains } if grains.contains(&g)));
-                if wall_grain || w.v.y.abs() * dt > max_step {
-                    let accel = w.load_y().abs() / w.mass;
-                    return format!(
-                        "the load on the {} wall: {pa} Pa on a wall of {:.3e} kg accelerates it by {accel:.3e} m/s^2 (it moves at {:.3e} m/s now). Raise walls.{}.mass or lower walls.{}.control.pressure",
-                        w.name, w.mass, w.v.y, w.name, w.name
-                    );
-                }
+            && let Some(w) = walls.iter().find(|w| matches!(w.control, Control::Load { .. }))
+        {
+            let wall_grain = grain.is_some_and(|g| matches!(&w.surface, crate::walls::Surface::Rough { grains } if grains.contains(&g)));
+            if wall_grain || w.v.y.abs() * dt > max_step {
+                let accel = w.load_y().abs() / w.mass;
+                return format!(
+                    "the load on the {} wall: {pa} Pa on a wall of {:.3e} kg accelerates it by {accel:.3e} m/s^2 (it moves at {:.3e} m/s now). Raise walls.{}.mass or lower walls.{}.control.pressure",
+                    w.name, w.mass, w.v.y, w.name, w.name
+                );
             }
+        }
         // Gravity: a grain falling freely (along gravity, as fast as a free fall since the
         // start) with nothing to stop it.
         if let Some(g) = grain.filter(|&g| g < p.n_free) {

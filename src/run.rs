@@ -293,11 +293,11 @@ pub fn run_report(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<
         let frame = frame_every.is_some_and(|every| k % every == 0);
         // Nothing is written of a state that failed its check: outputs hold only finite
         // numbers, and the stop is diagnosed in the summary.
-        if sample || frame {
-            if let Err(err) = e.health() {
-                error = Some(err);
-                break;
-            }
+        if (sample || frame)
+            && let Err(err) = e.health()
+        {
+            error = Some(err);
+            break;
         }
         if sample {
             or_stop!(record_energy(e, &mut outputs));
@@ -311,10 +311,10 @@ pub fn run_report(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<
         if frame {
             or_stop!(outputs.frame(e));
         }
-        if k % 1000 == 0 {
-            if let Some(b) = &bar {
-                b.set_position(k);
-            }
+        if k % 1000 == 0
+            && let Some(b) = &bar
+        {
+            b.set_position(k);
         }
         if stopping {
             error = Some(Error::Interrupted { step: e.steps(), time: e.time() });

@@ -142,8 +142,7 @@ fn snippets(bases: &[Value]) -> Vec<Value> {
             "shear".into(),
             "none".into(),
             "x y r".into(),
-        ]
-        .into_iter(),
+        ],
     );
     out
 }
