@@ -213,6 +213,11 @@ pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<B
         Grains::File { path, .. } => (file.as_ref().map_or(0, |f| f.0.len()) as u64, "grains.file.path".to_string(), format!("{path} ({} grains)", file.as_ref().map_or(0, |f| f.0.len()))),
         Grains::Pack(spec) => (spec.count as u64, "grains.pack.count".to_string(), spec.count.to_string()),
     };
+    match (&scene.grains, &file) {
+        (Grains::List(list), _) => consistency::given_coordinates(list.iter().map(|g| (Vec2::from(g.x), g.r)), |k| format!("grains.list[{k}]"))?,
+        (Grains::File { path, .. }, Some((grains, lines))) => consistency::given_coordinates(grains.iter().cloned(), |k| format!("the grain on line {} of {path}", lines[k]))?,
+        _ => {}
+    }
     // The x length the rough walls span: the periodic cell, the packing's region, or the
     // listed grains' extent.
     let mut length = boundary.period;
@@ -378,11 +383,11 @@ pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<B
     consistency::coordinates(scene, &p, &names, &walls)?;
     consistency::masses(&p, &names, &walls, mats)?;
     consistency::periodic_cell(&boundary, &p)?;
-    consistency::start_overlaps(&p, &walls, &boundary, &names, if packed { MAX_PACKING_OVERLAP } else { MAX_START_OVERLAP }, scene)?;
+    let worst = consistency::start_overlaps(&p, &walls, &boundary, &names, if packed { MAX_PACKING_OVERLAP } else { MAX_START_OVERLAP }, scene)?;
     // The largest overlap at the start, and the speed its stored energy would throw two
     // grains apart at: sqrt(E*/rho) (dn/r)^(5/4) (Hertz: the speed of an impact that
     // presses a contact in that far).
-    let start_overlap = crate::neighbor::largest_overlap(&p.x, &p.r, n_free, &boundary, f64::INFINITY).map(|(i, j, ratio)| {
+    let start_overlap = worst.map(|(i, j, ratio)| {
         let (a, b) = (&mats[p.material[i] as usize], &mats[p.material[j] as usize]);
         let release = (PairMaterial::mix(a, b).e_star / a.density.min(b.density)).sqrt() * ratio.powf(1.25);
         (ratio, format!("{} and {}", names.name(i, &p, &walls), names.name(j, &p, &walls)), release)
@@ -393,10 +398,10 @@ pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<B
     let imin = (0..n_free).min_by(|&a, &b| p.r[a].total_cmp(&p.r[b])).expect("at least one grain");
     let (r, m, i) = (p.r[imin], p.m[imin], p.inertia[imin]);
     let mat = &mats[p.material[imin] as usize];
-    let mut refs = vec![RefContact { r_star: r / 2.0, m_star: m / 2.0, pair: PairMaterial::mix(mat, mat), inv_tangential_mass: 2.0 / m + 2.0 * r * r / i }];
+    let mut refs = vec![RefContact::twin(r, m, i, PairMaterial::mix(mat, mat))];
     // Against each flat wall, with the wall's own material.
     for w in walls.iter().filter(|w: &&Wall| w.is_flat()) {
-        refs.push(RefContact { r_star: r, m_star: m, pair: PairMaterial::mix(mat, &mats[w.material]), inv_tangential_mass: 1.0 / m + r * r / i });
+        refs.push(RefContact::wall(r, m, i, PairMaterial::mix(mat, &mats[w.material])));
     }
     let ts = &scene.time_step;
     let time_step = match ts.rule {
@@ -412,10 +417,11 @@ pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<B
     let dt = time_step.dt_s;
     let steps = crate::run::step_count(scene.duration, dt, "duration")?;
     // The rows the summary keeps: a wall row per sample, an impact curve point per step
-    // in contact (at most every step).
+    // in contact (at most every step, and at most MAX_CURVE_POINTS).
     let samples = (scene.output.samples as f64).min(steps as f64);
     let (rows, field, value) = if scene.analysis == Analysis::Impact {
-        (steps as f64 + samples, "duration".to_string(), format!("{} s ({steps} steps of {dt:.3e} s)", scene.duration))
+        let curve = (steps as f64).min(crate::observe::impact::MAX_CURVE_POINTS as f64);
+        (curve + samples, "duration".to_string(), format!("{} s ({steps} steps of {dt:.3e} s)", scene.duration))
     } else {
         (samples, "output.samples".to_string(), scene.output.samples.to_string())
     };
@@ -562,7 +568,7 @@ impl Parts<'_> {
         } else {
             stages.push(Box::new(FinalIntegrate::<false>));
         }
-        stages.push(Box::new(Watchdog { max_overlap: 0.1, every: 100 }));
+        stages.push(Box::new(Watchdog { max_overlap: MAX_START_OVERLAP, every: 100 }));
         let mut setup = forces()?;
         if has_walls {
             setup.push(Box::new(FinishWalls::<E>));

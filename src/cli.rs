@@ -131,7 +131,8 @@ enum Command {
 const EXIT_CODES: &str = "Exit codes:
   0    success
   1    other failure (e.g. compare with comparisons outside their bound)
-  2    bad input: a scene, an option value, or an output folder grainlab may not use
+  2    bad input: a scene, a field an export cannot express, an option value, or an
+       output folder grainlab may not use
   3    I/O failure (a summary that could not be written is on stdout)
   4    run stopped unstable, with a diagnosis
   130  interrupted by SIGINT or SIGTERM, everything written";
@@ -199,7 +200,7 @@ fn execute(cli: Cli) -> Result<(), Error> {
             }
             let built = build_limited(&scene, threads, &limits)?;
             note!("{}", built.explain());
-            let opts = RunOptions { out: out.clone(), overwrite, progress: !quiet, duration, stop: Some(interrupt_flag()?) };
+            let opts = RunOptions { out: out.clone(), overwrite, progress: !quiet, duration, limits, stop: Some(interrupt_flag()?) };
             let RunReport { summary, ending, write_error, unwritten } = run_report(&scene, built, &opts)?;
             note!("{}", timing_table(&summary).trim_end());
             if let Some(w) = summary.energy.as_ref().and_then(|e| e.warning.as_ref()) {
@@ -238,7 +239,7 @@ fn execute(cli: Cli) -> Result<(), Error> {
             }
             let (Some(scene), Some(out)) = (scene, out) else { unreachable!("clap requires SCENE and --out without --explain-fields") };
             let scene = load_scene(&scene)?;
-            let files = grainlab::export::export_files(&scene, code, bench)?;
+            let files = grainlab::export::export_files(&scene, code, bench, &limits)?;
             let mut folder = OutFolder::claim(&out, overwrite, &format!("export {} {}", code.name(), scene.name))?;
             for (name, text) in files {
                 folder.write(name, text.as_bytes())?;
@@ -272,7 +273,7 @@ fn execute(cli: Cli) -> Result<(), Error> {
             for f in &variants {
                 vars.extend(Variant::family(f)?);
             }
-            let rows = sweep(&scene, &st, &vars, duration, |r| note!("{:<28} {:<16} dt = {:.3e} s  {:.1} ns/particle-step", r.variant, r.rule, r.dt_s, r.ns_per_particle_step))?;
+            let rows = sweep(&scene, &st, &vars, duration, &limits, |r| note!("{:<28} {:<16} dt = {:.3e} s  {:.1} ns/particle-step", r.variant, r.rule, r.dt_s, r.ns_per_particle_step))?;
             match out {
                 Some(path) => {
                     let mut w = CsvSeries::staged(&path)?;

@@ -110,6 +110,22 @@ pub fn coordinates(scene: &Scene, p: &Particles, names: &GrainNames, walls: &[Wa
     Ok(())
 }
 
+/// Grains given by the scene (listed, or read from a file), as (centre, radius), within
+/// [`crate::limits::MAX_COORDINATE_RADII`] largest radii of the origin: checked before
+/// anything is sized from where they lie (the rough walls span their extent).
+pub fn given_coordinates(grains: impl Iterator<Item = (Vec2, f64)> + Clone, name: impl Fn(usize) -> String) -> Result<(), Error> {
+    let r_max = grains.clone().map(|g| g.1).fold(0.0, f64::max);
+    let bound = crate::limits::MAX_COORDINATE_RADII * r_max;
+    match grains.enumerate().find(|(_, (x, _))| !(x.x.abs() <= bound && x.y.abs() <= bound)) {
+        Some((k, (x, _))) => Err(refuse(
+            name(k),
+            format!("at ({}, {}) m", x.x.shown(), x.y.shown()),
+            format!("within {bound:e} m of the origin ({:e} largest radii: further out, rounding reaches the overlaps the contact law resolves)", crate::limits::MAX_COORDINATE_RADII),
+        )),
+        None => Ok(()),
+    }
+}
+
 /// Masses and moments of inertia finite and positive (a radius or density at the edge of
 /// the floating-point range gives 0 or infinity).
 pub fn masses(p: &Particles, names: &GrainNames, walls: &[Wall], mats: &[Material]) -> Result<(), Error> {
@@ -143,19 +159,22 @@ pub fn periodic_cell(boundary: &Boundary, p: &Particles) -> Result<(), Error> {
     Ok(())
 }
 
-/// Grains on the right side of each flat wall and not overlapping it, nor each other (nor
-/// a rough wall's grains) by more than `bound` of the smaller radius. A packing that
-/// keeps more is refused by its packing fraction, with the fix.
-pub fn start_overlaps(p: &Particles, walls: &[Wall], boundary: &Boundary, names: &GrainNames, bound: f64, scene: &Scene) -> Result<(), Error> {
-    for w in walls.iter().filter(|w| w.is_flat()) {
+/// Grains on the right side of each wall (a flat wall's plane, a rough wall's line of
+/// glued grains) and not overlapping a flat wall, nor each other (nor a rough wall's
+/// grains), by more than `bound` of the smaller radius. A packing that keeps more is
+/// refused by its packing fraction, with the fix. Returns the largest overlap there is
+/// (grains i, j and the fraction), for the diagnosis of a run that goes wrong.
+pub fn start_overlaps(p: &Particles, walls: &[Wall], boundary: &Boundary, names: &GrainNames, bound: f64, scene: &Scene) -> Result<Option<(usize, usize, f64)>, Error> {
+    for w in walls {
         for i in 0..p.n_free {
             let gap = w.side * (p.x[i].y - w.y);
             let side = if w.side > 0.0 { "below" } else { "above" };
             if gap < 0.0 {
-                return Err(refuse(format!("walls.{}.y", w.name), w.y.shown(), format!("{side} every grain's centre ({} is at y = {} m)", names.name(i, p, walls), p.x[i].y.shown())));
+                let what = if w.is_flat() { "plane" } else { "glued grains' centres" };
+                return Err(refuse(format!("walls.{}.y", w.name), w.y.shown(), format!("a wall whose {what} lie {side} every grain's centre ({} is at y = {} m)", names.name(i, p, walls), p.x[i].y.shown())));
             }
             let ratio = (p.r[i] - gap) / p.r[i];
-            if ratio > bound {
+            if w.is_flat() && ratio > bound {
                 return Err(refuse(
                     format!("walls.{}.y", w.name),
                     w.y.shown(),
@@ -164,11 +183,13 @@ pub fn start_overlaps(p: &Particles, walls: &[Wall], boundary: &Boundary, names:
             }
         }
     }
-    if let Some((i, j, ratio)) = crate::neighbor::largest_overlap(&p.x, &p.r, p.n_free, boundary, bound)
+    let worst = crate::neighbor::largest_overlap(&p.x, &p.r, p.n_free, boundary, bound);
+    if let Some((i, j, ratio)) = worst
         && ratio > bound
     {
         if let (GrainNames::Pack, Grains::Pack(spec)) = (names, &scene.grains)
-            && i < p.n_free && j < p.n_free
+            && i < p.n_free
+            && j < p.n_free
         {
             return Err(refuse(
                 "grains.pack.packing_fraction",
@@ -184,7 +205,7 @@ pub fn start_overlaps(p: &Particles, walls: &[Wall], boundary: &Boundary, names:
             format!("grains that overlap by at most {bound} of the smaller radius at the start ({} overlaps it by {ratio:.3})", names.name(j, p, walls)),
         ));
     }
-    Ok(())
+    Ok(worst)
 }
 
 /// No grain, grain surface or wall moving more than [`MAX_STEP_MOVE`] of the smallest
@@ -221,37 +242,52 @@ pub fn motion(p: &Particles, walls: &[Wall], gravity: Vec2, names: &GrainNames, 
     Ok(())
 }
 
-/// The time step must be stable for every pair of materials the scene's grains and flat
-/// walls use, not only for the smallest grain's own material (which sets dt): each pair
-/// at the smallest radius, each grain of its own material's mass. Without
-/// `time_step.allow_unstable`, dt above the stiffest pair's limit is refused.
+/// The time step must be stable for every pair of materials the scene's grains and walls
+/// use, not only for the smallest grain's own material (which sets dt): each pair of
+/// free grains' materials at the smallest radius, each free grain against a rough wall's
+/// glued grain, and against each flat wall, every grain of its own material's mass.
+/// Without `time_step.allow_unstable`, dt above the stiffest pair's limit is refused.
 pub fn stable_for_every_pair(scene: &Scene, p: &Particles, walls: &[Wall], info: &crate::timestep::TimeStepInfo) -> Result<(), Error> {
     use crate::timestep::RefContact;
     if scene.time_step.allow_unstable {
         return Ok(());
     }
     let mats = &scene.materials;
-    let mut used: Vec<usize> = p.material[..p.n_free].iter().map(|&m| m as usize).collect();
-    used.sort_unstable();
-    used.dedup();
+    let used = |grains: std::ops::Range<usize>| {
+        let mut m: Vec<usize> = p.material[grains].iter().map(|&m| m as usize).collect();
+        m.sort_unstable();
+        m.dedup();
+        m
+    };
+    let (free, glued) = (used(0..p.n_free), used(p.n_free..p.len()));
     let r = p.r[..p.n_free].iter().cloned().fold(f64::INFINITY, f64::min);
     let shape = scene.grain_shape;
-    let grain = |k: usize| {
+    // A grain of radius `r` and material `k`: (radius, mass, moment of inertia).
+    let grain = |r: f64, k: usize| {
         let m = shape.mass(r, mats[k].density);
-        (m, shape.inertia(r, m))
+        (r, m, shape.inertia(r, m))
     };
     let mut refs = Vec::new();
     let mut names = Vec::new();
-    for (ia, &a) in used.iter().enumerate() {
-        let (ma, ia_) = grain(a);
-        for &b in &used[ia..] {
-            let (mb, ib) = grain(b);
-            refs.push(RefContact { r_star: r / 2.0, m_star: ma * mb / (ma + mb), pair: PairMaterial::mix(&mats[a], &mats[b]), inv_tangential_mass: 1.0 / ma + 1.0 / mb + r * r / ia_ + r * r / ib });
+    for (ia, &a) in free.iter().enumerate() {
+        let ga = grain(r, a);
+        for &b in &free[ia..] {
+            let pair = PairMaterial::mix(&mats[a], &mats[b]);
+            refs.push(if a == b { RefContact::twin(r, ga.1, ga.2, pair) } else { RefContact::grains(ga, grain(r, b), pair) });
             names.push(format!("materials[{a}] against materials[{b}]"));
         }
-        for w in walls.iter().filter(|w| w.is_flat()) {
-            refs.push(RefContact { r_star: r, m_star: ma, pair: PairMaterial::mix(&mats[a], &mats[w.material]), inv_tangential_mass: 1.0 / ma + r * r / ia_ });
-            names.push(format!("materials[{a}] against the {} wall", w.name));
+        for w in walls {
+            match &w.surface {
+                Surface::Flat => {
+                    refs.push(RefContact::wall(r, ga.1, ga.2, PairMaterial::mix(&mats[a], &mats[w.material])));
+                    names.push(format!("materials[{a}] against the {} wall", w.name));
+                }
+                Surface::Rough { .. } if glued.contains(&w.material) => {
+                    refs.push(RefContact::grains(ga, grain(w.glued_radius, w.material), PairMaterial::mix(&mats[a], &mats[w.material])));
+                    names.push(format!("materials[{a}] against the {} wall's grains", w.name));
+                }
+                Surface::Rough { .. } => {}
+            }
         }
     }
     let friction = scene.model.tangential != crate::scene::TangentialSpec::Frictionless;

@@ -70,7 +70,7 @@ impl Domain {
     /// moved more than that in its last step.
     pub fn check(&self, p: &Particles, walls: &[Wall], at_build: &[Vec2], boundary: &Boundary, half_skin: f64) -> Option<Fault> {
         if let [b, t] = walls {
-            let (bottom, top) = (surface(b), surface(t));
+            let (bottom, top) = (b.contact_surface(), t.contact_surface());
             if !(top > bottom) {
                 return Some(Fault::WallsCrossed { gap: top - bottom });
             }
@@ -80,32 +80,31 @@ impl Domain {
         }
         let (ylo, yhi) = match (self.y, walls) {
             (Some([a, b]), _) => (a, b),
-            (None, [b, t]) => (surface(b) - self.wall_margin, surface(t) + self.wall_margin),
+            (None, [b, t]) => (b.contact_surface() - self.wall_margin, t.contact_surface() + self.wall_margin),
             _ => (f64::NEG_INFINITY, f64::INFINITY),
         };
         let [xlo, xhi] = self.x.unwrap_or([f64::NEG_INFINITY, f64::INFINITY]);
         let inside = |x: &Vec2| x.x >= xlo && x.x <= xhi && x.y >= ylo && x.y <= yhi;
-        if let Some(i) = (0..p.n_free).find(|&i| !inside(&p.x[i])) {
-            return Some(Fault::Left { grain: i, at: p.x[i] });
-        }
-        if at_build.len() == p.len() {
-            let limit = half_skin + self.max_step;
-            let far = |i: usize| boundary.image(p.x[i] - at_build[i]).norm();
-            if let Some(i) = (0..p.len()).find(|&i| !(far(i) <= limit)) {
-                return Some(Fault::Jumped { grain: i, moved: far(i) - half_skin });
+        // One pass: a grain outside, or one further from its place at the last build than
+        // half the skin and one step's most (squared, no root but for the message).
+        let check_moves = at_build.len() == p.len();
+        let limit = half_skin + self.max_step;
+        let limit2 = limit * limit;
+        for i in 0..p.len() {
+            if i < p.n_free && !inside(&p.x[i]) {
+                return Some(Fault::Left { grain: i, at: p.x[i] });
+            }
+            if check_moves {
+                let far2 = boundary.image(p.x[i] - at_build[i]).norm_squared();
+                if !(far2 <= limit2) {
+                    return Some(Fault::Jumped { grain: i, moved: far2.sqrt() - half_skin });
+                }
             }
         }
         None
     }
 }
 
-/// The contact surface of a wall: its plane, or the far side of its glued grains, m.
-fn surface(w: &Wall) -> f64 {
-    match &w.surface {
-        crate::walls::Surface::Flat => w.y,
-        crate::walls::Surface::Rough { .. } => w.y + w.side * w.glued_radius,
-    }
-}
 
 /// What the build knew that helps tell why a run went wrong.
 #[derive(Clone, Debug, Default)]

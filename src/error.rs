@@ -9,8 +9,9 @@ pub mod exit {
     pub const SUCCESS: u8 = 0;
     /// A failure of no class below (e.g. `compare` with comparisons outside their bound).
     pub const OTHER: u8 = 1;
-    /// Bad input: a scene refused, a command-line value refused, an output folder
-    /// grainlab may not use. clap exits with 2 on usage errors too.
+    /// Bad input: a scene refused, a field an export cannot express, a command-line value
+    /// refused, an output folder grainlab may not use. clap exits with 2 on usage errors
+    /// too.
     pub const BAD_INPUT: u8 = 2;
     /// A file could not be read or written (also when only `summary.json` could not be
     /// written: the summary is then on stdout).
@@ -42,6 +43,9 @@ pub enum Error {
     /// write, or an earlier run's files and no `--overwrite`).
     #[error("output folder {dir}: {why}")]
     Folder { dir: String, why: String },
+    /// A scene field a reference code cannot express, refused by the exporter by name.
+    #[error("{0}")]
+    Export(String),
     /// A run that went unstable, with a diagnosis.
     #[error("run stopped at step {step} (t = {time:.6e} s): {what}\n  what to change: {advice}")]
     Unstable { step: u64, time: f64, what: String, advice: String },
@@ -62,7 +66,7 @@ impl Error {
     /// The process exit code for this error ([`exit`]).
     pub fn exit_code(&self) -> u8 {
         match self {
-            Error::Invalid { .. } | Error::Scene(_) | Error::Parse { .. } | Error::BadOption { .. } | Error::Folder { .. } => exit::BAD_INPUT,
+            Error::Invalid { .. } | Error::Scene(_) | Error::Parse { .. } | Error::BadOption { .. } | Error::Folder { .. } | Error::Export(_) => exit::BAD_INPUT,
             Error::Io { .. } => exit::IO_FAILURE,
             Error::Unstable { .. } => exit::UNSTABLE,
             Error::Interrupted { .. } => exit::INTERRUPTED,

@@ -32,6 +32,10 @@ pub const MAX_MATERIALS: usize = 256;
 /// one core, far beyond any study here; more comes from a dt that came out absurdly small.
 pub const MAX_STEPS: f64 = 1e12;
 
+/// Most ParaView frames a run writes: each rewrites the `.pvd` index and the output
+/// folder's manifest, whose sizes grow with the frames.
+pub const MAX_FRAMES: u64 = 10_000;
+
 /// How far from the origin, in largest grain radii, a coordinate (grain, wall, periodic
 /// cell, packing region) may lie: beyond, the rounding of positions (2.2e-16 of the
 /// coordinate) approaches the overlaps the contact law resolves, and products of
@@ -54,14 +58,17 @@ impl Default for Limits {
 }
 
 impl Limits {
-    /// Half the machine's memory.
+    /// Half the machine's memory (read once).
     pub fn machine() -> Self {
-        let total = std::fs::read_to_string("/proc/meminfo").ok().and_then(|s| {
-            let line = s.lines().find(|l| l.starts_with("MemTotal:"))?;
-            let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
-            Some(kib.saturating_mul(1024))
-        });
-        Limits { memory_bytes: total.unwrap_or(16 << 30) / 2 }
+        static MACHINE: std::sync::OnceLock<Limits> = std::sync::OnceLock::new();
+        *MACHINE.get_or_init(|| {
+            let total = std::fs::read_to_string("/proc/meminfo").ok().and_then(|s| {
+                let line = s.lines().find(|l| l.starts_with("MemTotal:"))?;
+                let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+                Some(kib.saturating_mul(1024))
+            });
+            Limits { memory_bytes: total.unwrap_or(16 << 30) / 2 }
+        })
     }
 
     /// A budget of `bytes`.

@@ -405,19 +405,19 @@ pub fn largest_overlap(x: &[Vec2], r: &[f64], n_free: usize, boundary: &Boundary
 /// time depends on how far apart they are.
 struct CellList<'a> {
     periodic: bool,
-    /// Columns and rows of the grid (rows up to 2^31 in the sparse case).
+    /// Columns and rows of the grid (each up to 2^31 in the sparse case).
     nx: u64,
     ny: u64,
-    /// The cell of each grain, `cy * nx + cx`.
-    cell: Vec<u64>,
     kind: Cells<'a>,
 }
 
 enum Cells<'a> {
-    /// The grains of cell c are `items[start[c]..start[c + 1]]`.
-    Dense { start: &'a [u32], items: &'a [u32] },
-    /// The cells of the grains in order (`keys`) and the grains in that order (`items`).
-    Sparse { keys: Vec<u64>, items: Vec<u32> },
+    /// The cell of each grain (`cy * nx + cx`); the grains of cell c are
+    /// `items[start[c]..start[c + 1]]`.
+    Dense { cell: Vec<u32>, start: &'a [u32], items: &'a [u32] },
+    /// The cell of each grain, the cells of the grains sorted by cell (`keys`) and the
+    /// grains in that order (`items`).
+    Sparse { cell: Vec<u64>, keys: Vec<u64>, items: Vec<u32> },
 }
 
 /// Most cells of a dense grid for `n` grains.
@@ -427,6 +427,14 @@ fn max_dense_cells(n: usize) -> f64 {
 
 /// Most columns or rows a grid counts (2^31): grains beyond share the edge cells.
 const MAX_CELLS_PER_AXIS: f64 = 2147483648.0;
+
+/// How many cells at least `reach` wide fit along a length `l`: at least one, counted in
+/// floating point (the count for a far-flung set of grains fits no integer), at most
+/// [`MAX_CELLS_PER_AXIS`].
+pub(crate) fn cells_along(l: f64, reach: f64) -> f64 {
+    let c = (l / reach).floor();
+    if c.is_finite() { c.clamp(1.0, MAX_CELLS_PER_AXIS) } else { MAX_CELLS_PER_AXIS }
+}
 
 impl<'a> CellList<'a> {
     fn new(x: &[Vec2], r: &[f64], boundary: &Boundary, skin: f64, cell_start: &'a mut Vec<u32>, cell_items: &'a mut Vec<u32>) -> Self {
@@ -441,12 +449,7 @@ impl<'a> CellList<'a> {
         let periodic = boundary.is_periodic();
         let (x0, lx) = if periodic { (boundary.x_min, boundary.period) } else { (lo.x, (hi.x - lo.x).max(reach)) };
         let ly = (hi.y - lo.y).max(reach);
-        // In floating point: the counts of a far-flung set of grains do not fit an integer.
-        let count = |l: f64| {
-            let c = (l / reach).floor();
-            if c.is_finite() { c.clamp(1.0, MAX_CELLS_PER_AXIS) } else { MAX_CELLS_PER_AXIS }
-        };
-        let (mut fx, fy) = (count(lx), count(ly));
+        let (mut fx, fy) = (cells_along(lx, reach), cells_along(ly, reach));
         // A periodic row of fewer than three cells would meet itself: one cell then.
         if periodic && fx < 3.0 {
             fx = 1.0;
@@ -463,24 +466,33 @@ impl<'a> CellList<'a> {
             let cy = (((p.y - lo.y) / wy).max(0.0) as u64).min(ny - 1);
             cy * nx + cx
         };
-        let cell: Vec<u64> = x.iter().map(cell_of).collect();
         let kind = if fx * fy <= max_dense_cells(n) {
-            let as_u32: Vec<u32> = cell.iter().map(|&c| c as u32).collect();
-            bin_into_cells(&as_u32, (nx * ny) as usize, cell_start, cell_items);
-            Cells::Dense { start: &cell_start[..], items: &cell_items[..] }
+            // The grid has at most 4n + 64 cells: each index fits a u32.
+            let cell: Vec<u32> = x.iter().map(|p| cell_of(p) as u32).collect();
+            bin_into_cells(&cell, (nx * ny) as usize, cell_start, cell_items);
+            Cells::Dense { cell, start: &cell_start[..], items: &cell_items[..] }
         } else {
-            let mut order: Vec<u32> = (0..n as u32).collect();
-            order.sort_unstable_by_key(|&i| (cell[i as usize], i));
-            Cells::Sparse { keys: order.iter().map(|&i| cell[i as usize]).collect(), items: order }
+            let cell: Vec<u64> = x.iter().map(cell_of).collect();
+            let mut items: Vec<u32> = (0..n as u32).collect();
+            items.sort_unstable_by_key(|&i| (cell[i as usize], i));
+            Cells::Sparse { keys: items.iter().map(|&i| cell[i as usize]).collect(), cell, items }
         };
-        CellList { periodic, nx, ny, cell, kind }
+        CellList { periodic, nx, ny, kind }
     }
 
     /// Call `visit` with each grain of grain i's cell and the eight around it (i
     /// included), each cell once, until it returns false.
     #[inline]
-    fn candidates(&self, i: usize, mut visit: impl FnMut(usize) -> bool) {
-        let c = self.cell[i];
+    fn candidates(&self, i: usize, visit: impl FnMut(usize) -> bool) {
+        match &self.kind {
+            Cells::Dense { cell, start, items } => self.around(cell[i] as u64, visit, |d| &items[start[d as usize] as usize..start[d as usize + 1] as usize]),
+            Cells::Sparse { cell, keys, items } => self.around(cell[i], visit, |d| &items[keys.partition_point(|&key| key < d)..keys.partition_point(|&key| key <= d)]),
+        }
+    }
+
+    /// [`CellList::candidates`] around cell `c`, with `grains(d)` the grains of cell d.
+    #[inline(always)]
+    fn around<'g>(&self, c: u64, mut visit: impl FnMut(usize) -> bool, grains: impl Fn(u64) -> &'g [u32]) {
         let (cx, cy) = ((c % self.nx) as i64, (c / self.nx) as i64);
         let (nx, ny) = (self.nx as i64, self.ny as i64);
         let mut around = [0u64; 9];
@@ -508,11 +520,7 @@ impl<'a> CellList<'a> {
             if k > 0 && around[k - 1] == d {
                 continue;
             }
-            let grains = match &self.kind {
-                Cells::Dense { start, items } => &items[start[d as usize] as usize..start[d as usize + 1] as usize],
-                Cells::Sparse { keys, items } => &items[keys.partition_point(|&key| key < d)..keys.partition_point(|&key| key <= d)],
-            };
-            for &j in grains {
+            for &j in grains(d) {
                 if !visit(j as usize) {
                     return;
                 }

@@ -14,7 +14,7 @@ use serde::{Deserialize, Serialize};
 use crate::boundary::Boundary;
 use crate::dim::Vec2;
 use crate::error::{Error, check};
-use crate::neighbor::{Neighbours, bin_into_cells};
+use crate::neighbor::{Neighbours, bin_into_cells, cells_along};
 
 /// A distribution of radii, m. Normal and lognormal draws are truncated to [min, max].
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
@@ -207,8 +207,7 @@ impl Grid {
     fn new(x0: f64, x1: f64, y0: f64, y1: f64, periodic: bool, reach: f64, n: usize) -> Self {
         let (lx, ly) = ((x1 - x0).max(reach), (y1 - y0).max(reach));
         // Counted in floating point, so that no region overflows an integer.
-        let count = |l: f64| if (l / reach).is_finite() { (l / reach).floor().clamp(1.0, 1e15) } else { 1e15 };
-        let (mut fx, mut fy) = (count(lx), count(ly));
+        let (mut fx, mut fy) = (cells_along(lx, reach), cells_along(ly, reach));
         // Keep the grid modest when the grains are few and far apart.
         let max_cells = (4 * n + 64) as f64;
         if fx * fy > max_cells {

@@ -9,7 +9,7 @@ use std::time::Instant;
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 
-use crate::build::{Built, build};
+use crate::build::Built;
 use crate::error::Error;
 use crate::observe::energy::EnergyRow;
 use crate::observe::impact::{ImpactObserver, ImpactSummary};
@@ -32,6 +32,8 @@ pub struct RunOptions {
     pub progress: bool,
     /// Override the scene's duration, s.
     pub duration: Option<f64>,
+    /// What a scene [`run_scene`] builds may ask of the machine (default: half its memory).
+    pub limits: crate::limits::Limits,
     /// Set (by a SIGINT/SIGTERM handler, or a test) to end the run after the step under
     /// way: it then writes everything with `status: "interrupted"` and ends with
     /// [`Error::Interrupted`]. Read once a step (a relaxed atomic load).
@@ -132,14 +134,20 @@ impl Outputs {
 /// Steps of a run of `duration` s at `dt`, and the steps per output sample: the schedule
 /// every run follows, and that exported decks and calibrations copy.
 pub fn schedule(duration: f64, dt: f64, samples: u64) -> (u64, u64) {
-    let total = (duration / dt).ceil().max(1.0) as u64;
+    let total = steps_of(duration, dt) as u64;
     (total, (total / samples.max(1)).max(1))
+}
+
+/// The steps a run of `duration` s takes at `dt` (at least one), as a float: NaN or
+/// infinite for a dt that is not finite and > 0 ([`step_count`] refuses those).
+fn steps_of(duration: f64, dt: f64) -> f64 {
+    (duration / dt).ceil().max(1.0)
 }
 
 /// The steps of a run of `duration` s at `dt`, refused when dt is not finite and > 0 or
 /// the count exceeds [`crate::limits::MAX_STEPS`] (`field` names what set the duration).
 pub fn step_count(duration: f64, dt: f64, field: &str) -> Result<u64, Error> {
-    let steps = (duration / dt).ceil().max(1.0);
+    let steps = steps_of(duration, dt);
     if !(dt.is_finite() && dt > 0.0) {
         return Err(Error::Invalid { field: "time_step".into(), value: format!("dt = {dt:e} s"), allowed: "a rule that gives a finite dt > 0 s (check the materials' moduli and densities and the speeds)".into() });
     }
@@ -182,7 +190,7 @@ impl RunReport {
 
 /// Build and run a scene.
 pub fn run_scene(scene: &Scene, opts: &RunOptions) -> Result<Summary, Error> {
-    let built = build(scene)?;
+    let built = crate::build::build_limited(scene, 1, &opts.limits)?;
     run_built(scene, built, opts)
 }
 
@@ -286,6 +294,12 @@ pub fn run_report(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<
             break;
         }
         if let Some(o) = impact.as_mut() {
+            // The observer records every step (its curve is an output): every step's state
+            // is checked first, cheap for the one or two grains of an impact.
+            if let Err(err) = e.health() {
+                error = Some(err);
+                break;
+            }
             o.observe(e);
         }
         walls_avg.accumulate(e);
@@ -335,7 +349,7 @@ pub fn run_report(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<
     let timings = e.timings();
     let total_t: f64 = timings.iter().map(|t| t.1.as_secs_f64()).sum::<f64>().max(f64::MIN_POSITIVE);
     let stage_timing = timings.iter().map(|(s, d)| StageTime { stage: s.clone(), seconds: d.as_secs_f64(), share: d.as_secs_f64() / total_t }).collect();
-    let shear = (scene.analysis == Analysis::Shear && wall_rows.len() >= 4).then(|| shear_summary(&wall_rows, e, built.length));
+    let shear = (scene.analysis == Analysis::Shear && wall_rows.len() >= 4).then(|| shear_summary(&wall_rows, e.particles(), built.length));
     let p = e.particles();
     let summary = Summary {
         scene: scene.name.clone(),
@@ -359,6 +373,15 @@ pub fn run_report(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<
         shear,
         stage_timing,
     };
+    // Every number in the summary is finite (an undefined one is `None`): a number that is
+    // not would be written as `null` without a word, so the run says so instead.
+    let mut summary = summary;
+    if let Some(field) = crate::finite::non_finite_column(&summary) {
+        let what = format!("the summary's {field} is not finite (written as null): a fault of grainlab's checks, please report it with the scene");
+        summary.status = "stopped".into();
+        summary.error = Some(summary.error.map_or(what.clone(), |e| format!("{e}; {what}")));
+        error.get_or_insert(Error::Other(what));
+    }
     // Everything is tried even when one write fails; the first failure is kept.
     if let Some(folder) = outputs.folder.as_mut() {
         for (series, name) in [(outputs.energy.take(), "energy.csv"), (outputs.walls.take(), "walls.csv")] {
@@ -375,11 +398,12 @@ pub fn run_report(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<
     Ok(RunReport { summary, ending: error, write_error, unwritten })
 }
 
-fn shear_summary(rows: &[WallRow], e: &dyn crate::build::Engine, length: f64) -> ShearSummary {
-    let p = e.particles();
+/// The shear estimates of a run's wall rows, and the packing fraction at the last row (its
+/// gap: of a state that passed its checks, also when the run stopped after it).
+fn shear_summary(rows: &[WallRow], p: &crate::particles::Particles, length: f64) -> ShearSummary {
     let area: f64 = (0..p.n_free).map(|i| std::f64::consts::PI * p.r[i] * p.r[i]).sum();
-    let w = e.walls();
-    stress_estimates(rows, Some(area / (length * (w[1].y - w[0].y))))
+    let gap = rows.last().map_or(f64::NAN, |r| r.gap_m);
+    stress_estimates(rows, Some(area / (length * gap)).filter(|f| f.is_finite()))
 }
 
 /// Time averages of the wall stresses over the second half of a wall series, in 10

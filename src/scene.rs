@@ -10,7 +10,7 @@ use serde::{Deserialize, Serialize};
 use crate::contact::LeverArm;
 use crate::dim::GrainShape;
 use crate::error::{Error, check};
-use crate::limits::MAX_MATERIALS;
+use crate::limits::{MAX_FRAMES, MAX_MATERIALS};
 use crate::material::Material;
 use crate::pack::RadiusDist;
 
@@ -495,6 +495,7 @@ impl Scene {
         check(finite_pos(self.duration), "", "duration", self.duration, "> 0 s")?;
         check(finite_pos(self.neighbor.skin) && self.neighbor.skin <= 2.0, "neighbor", "skin", self.neighbor.skin, "(0, 2] smallest diameters")?;
         check(self.output.samples >= 1, "output", "samples", self.output.samples, ">= 1")?;
+        check(self.output.frames <= MAX_FRAMES, "output", "frames", self.output.frames, &format!("0 to {MAX_FRAMES} (each frame rewrites the .pvd index and the manifest)"))?;
         if self.analysis == Analysis::Shear {
             check(self.walls.is_some() && self.domain.periodic_x.is_some(), "", "analysis", "shear", "a scene with walls and periodic_x")?;
         }

@@ -108,7 +108,7 @@ fn abs_diff(a: Option<f64>, b: Option<f64>) -> Option<f64> {
 }
 
 /// Run `scene` at every step setting for every variant.
-pub fn sweep(scene: &Scene, steps: &[Step], variants: &[Variant], duration: Option<f64>, mut progress: impl FnMut(&SweepRow)) -> Result<Vec<SweepRow>, Error> {
+pub fn sweep(scene: &Scene, steps: &[Step], variants: &[Variant], duration: Option<f64>, limits: &crate::limits::Limits, mut progress: impl FnMut(&SweepRow)) -> Result<Vec<SweepRow>, Error> {
     if steps.is_empty() {
         return Err(Error::BadOption { option: "--steps/--rayleigh".into(), value: "none".into(), allowed: "at least one time step".into() });
     }
@@ -128,7 +128,7 @@ pub fn sweep(scene: &Scene, steps: &[Step], variants: &[Variant], duration: Opti
                 Step::Rayleigh(f) => TimeStepRule::RayleighFraction { fraction: f },
             };
             let t0 = Instant::now();
-            let sum = run_scene(&s, &RunOptions { duration, ..RunOptions::default() })?;
+            let sum = run_scene(&s, &RunOptions { duration, limits: *limits, ..RunOptions::default() })?;
             let wall = t0.elapsed().as_secs_f64();
             let imp = sum.impact;
             let ratio = sum.shear.as_ref().and_then(|s| s.stress_ratio);

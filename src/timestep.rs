@@ -26,6 +26,29 @@ pub struct RefContact {
     pub inv_tangential_mass: f64,
 }
 
+impl RefContact {
+    /// Two like grains of radius `r`, mass `m` and moment of inertia `i`, of one material
+    /// (`pair` mixes it with itself).
+    pub fn twin(r: f64, m: f64, i: f64, pair: PairMaterial) -> Self {
+        RefContact { r_star: r / 2.0, m_star: m / 2.0, pair, inv_tangential_mass: 2.0 / m + 2.0 * r * r / i }
+    }
+    /// Two grains `a` and `b`, each (radius, mass, moment of inertia), whose materials
+    /// `pair` mixes.
+    pub fn grains(a: (f64, f64, f64), b: (f64, f64, f64), pair: PairMaterial) -> Self {
+        RefContact {
+            r_star: crate::material::reduced(a.0, b.0),
+            m_star: crate::material::reduced(a.1, b.1),
+            pair,
+            inv_tangential_mass: 1.0 / a.1 + 1.0 / b.1 + a.0 * a.0 / a.2 + b.0 * b.0 / b.2,
+        }
+    }
+    /// A grain of radius `r`, mass `m`, moment of inertia `i` against a flat wall (R* = r,
+    /// m* = m).
+    pub fn wall(r: f64, m: f64, i: f64, pair: PairMaterial) -> Self {
+        RefContact { r_star: r, m_star: m, pair, inv_tangential_mass: 1.0 / m + r * r / i }
+    }
+}
+
 /// The chosen time step and what it means.
 #[derive(Clone, Copy, Debug, Serialize)]
 pub struct TimeStepInfo {

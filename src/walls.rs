@@ -74,6 +74,11 @@ impl Wall {
     pub fn is_flat(&self) -> bool {
         self.surface == Surface::Flat
     }
+    /// Where the grains touch the wall in y: its plane, or the far side of its glued
+    /// grains (`y` is their centres' line), m.
+    pub fn contact_surface(&self) -> f64 {
+        self.y + self.side * self.glued_radius
+    }
 }
 
 /// A rough wall's grains and their rigid move this step.

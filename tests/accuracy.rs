@@ -55,7 +55,7 @@ fn the_sweep_measures_errors_against_converged_and_closed_form() {
     // and its error against its own finest run is zero there by definition.
     let s = head_on(glass(0.5), 1e-3, 1.0, 50.0);
     let steps: Vec<Step> = [50.0, 100.0, 200.0, 400.0].iter().map(|&n| Step::PerContact(n)).collect();
-    let rows = sweep(&s, &steps, &[Variant::Scene], None, |_| {}).unwrap();
+    let rows = sweep(&s, &steps, &[Variant::Scene], None, &Default::default(), |_| {}).unwrap();
     assert_eq!(rows.len(), 4);
     for r in &rows {
         assert!(r.restitution_err_input.unwrap() < 0.15 / r.steps_per_contact, "{r:?}");

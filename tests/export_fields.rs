@@ -276,7 +276,7 @@ fn same_run(a: &[f64], b: &[f64]) -> bool {
 type Export = Result<Vec<(&'static str, String)>, String>;
 
 fn export(s: &Scene, code: Code) -> Export {
-    export_files(s, code, false).map_err(|e| e.to_string())
+    export_files(s, code, false, &Default::default()).map_err(|e| e.to_string())
 }
 
 /// Whether a refusal names `path` (normalised), as a whole path.
@@ -646,7 +646,7 @@ fn one_value_fields_admit_no_other_value() {
 fn named(name: &str, code: Code) -> Vec<(&'static str, String)> {
     let mut s = grainlab::scenes::builtin("collision").unwrap();
     s.name = name.to_string();
-    export_files(&s, code, false).unwrap()
+    export_files(&s, code, false, &Default::default()).unwrap()
 }
 
 #[test]

@@ -8,7 +8,7 @@
 //! - no run beyond the step bound,
 //! - no number that is not finite in the summary or in any file written.
 //!
-//! `cargo test` runs `FUZZ_CASES` cases (default 500, about 20 s); CI runs more
+//! `cargo test` runs `FUZZ_CASES` cases (default 1000, a few seconds); CI runs more
 //! (`.ci/run`). A failure prints the case (base, mutations, seed, broken text) that
 //! reproduces it: `FUZZ_CASE=2,1,9139556803309287229,2 cargo test --test fuzz`.
 
@@ -273,22 +273,30 @@ fn assert_files_finite(dir: &Path) {
         }
     }
     for f in files {
-        let text = std::fs::read_to_string(&f).unwrap();
-        let lower = text.to_ascii_lowercase();
-        for bad in ["nan", "inf"] {
-            // Words that hold the letters: "infinity" aside, no file has them but a number.
-            let found = lower.match_indices(bad).any(|(k, _)| {
-                let before = lower[..k].chars().last().unwrap_or(' ');
-                !before.is_ascii_alphabetic() && !lower[k..].starts_with("info")
-            });
-            assert!(!found, "{} holds `{bad}`:\n{}", f.display(), &text[..text.len().min(2000)]);
-        }
+        assert_finite_text(&f.display().to_string(), &std::fs::read_to_string(&f).unwrap());
+    }
+}
+
+/// No `nan` or `inf` in `text` that starts a word (the words of an output's text, `info`
+/// aside, hold neither): a number that is not finite, however it is spelt.
+fn assert_finite_text(name: &str, text: &str) {
+    let lower = text.to_ascii_lowercase();
+    for bad in ["nan", "inf"] {
+        let found = lower.match_indices(bad).any(|(k, _)| {
+            let before = lower[..k].chars().last().unwrap_or(' ');
+            !before.is_ascii_alphabetic() && !lower[k..].starts_with("info")
+        });
+        assert!(!found, "{name} holds `{bad}`:\n{}", &text[..text.len().min(2000)]);
     }
 }
 
 /// Exercise one mutated scene text.
 fn exercise(text: &str, dir: &Path, export: bool, tally: &mut Tally, case: &str) -> Result<(), TestCaseError> {
-    let scene = match Scene::from_json(text) {
+    // Through the command line's loader: a scene file (bounded read, relative paths).
+    let file = dir.join("scene.json");
+    std::fs::write(&file, text).unwrap();
+    let limits = Limits::with_memory(BUDGET);
+    let scene = match grainlab::scenes::load(file.to_str().unwrap(), &limits) {
         Ok(s) => s,
         Err(e) => {
             tally.parse += 1;
@@ -301,7 +309,6 @@ fn exercise(text: &str, dir: &Path, export: bool, tally: &mut Tally, case: &str)
             return Ok(());
         }
     };
-    let limits = Limits::with_memory(BUDGET);
     let built = match grainlab::build::build_limited(&scene, 1, &limits) {
         Ok(b) => b,
         Err(e) => {
@@ -334,11 +341,11 @@ fn exercise(text: &str, dir: &Path, export: bool, tally: &mut Tally, case: &str)
     assert_files_finite(&out);
     if export {
         for code in [grainlab::export::Code::Liggghts, grainlab::export::Code::Yade] {
-            match grainlab::export::export_files(&scene, code, false) {
+            match grainlab::export::export_files(&scene, code, false, &limits) {
                 Ok(files) => {
                     tally.exported += 1;
                     for (name, text) in files {
-                        prop_assert!(!text.to_ascii_lowercase().contains(" nan"), "{name} holds NaN");
+                        assert_finite_text(name, &text);
                     }
                 }
                 Err(e) => {
@@ -369,7 +376,7 @@ fn case_text(bases: &[Value], snippets: &[Value], base: usize, mutations: usize,
 }
 
 fn cases() -> u32 {
-    std::env::var("FUZZ_CASES").ok().and_then(|s| s.parse().ok()).unwrap_or(500)
+    std::env::var("FUZZ_CASES").ok().and_then(|s| s.parse().ok()).unwrap_or(1000)
 }
 
 #[test]

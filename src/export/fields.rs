@@ -334,7 +334,7 @@ fn entry(path: &str) -> &'static Field {
 pub fn refuse(code: Code, path: &str, value: impl std::fmt::Display, detail: &str) -> Error {
     let why = entry(path).decision(code).refused.unwrap_or_else(|| panic!("src/export/fields.rs: {path} is refused for {} without a reason", code.name()));
     let detail = if detail.is_empty() { String::new() } else { format!(" ({detail})") };
-    Error::Other(format!("export to {}: {path} = {value} cannot be expressed: {why}{detail}", code.name()))
+    Error::Export(format!("export to {}: {path} = {value} cannot be expressed: {why}{detail}", code.name()))
 }
 
 /// The table's note of what `code` does differently for `path`.

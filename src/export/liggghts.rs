@@ -82,7 +82,7 @@ pub(crate) fn deck(scene: &Scene, ex: &Exported) -> Result<String, Error> {
         match &wall.surface {
             Surface::Flat => {
                 let shear = if wall.v.x != 0.0 { format!(" shear x {}", f(wall.v.x)) } else { String::new() };
-                let _ = writeln!(w, "fix w_{name} free wall/gran {law} primitive type {} yplane {}{shear}", ex_wall_type(scene, name), f(wall.y));
+                let _ = writeln!(w, "fix w_{name} free wall/gran {law} primitive type {} yplane {}{shear}", wall.material + 1 /* its material's atom type */, f(wall.y));
             }
             Surface::Rough { grains } => {
                 let (a, b) = (grains.start + 1, grains.end);
@@ -161,8 +161,3 @@ pub(crate) fn name_of<T: serde::Serialize>(v: &T) -> String {
     }
 }
 
-/// The LIGGGHTS atom type of a flat wall: its material + 1.
-fn ex_wall_type(scene: &Scene, name: &str) -> usize {
-    let w = scene.walls.as_ref().expect("a wall exists");
-    1 + if name == "bottom" { w.bottom.material } else { w.top.material }
-}

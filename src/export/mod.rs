@@ -31,7 +31,7 @@ use std::path::Path;
 
 use serde::Serialize;
 
-use crate::build::{Built, build};
+use crate::build::Built;
 use crate::dim::GrainShape;
 use crate::error::Error;
 use crate::scene::{Analysis, ControlSpec, Grains, Scene, TangentialSpec};
@@ -109,7 +109,7 @@ pub(crate) struct Exported {
     pub bench: bool,
 }
 
-pub(crate) fn prepare(scene: &Scene, code: Code) -> Result<Exported, Error> {
+pub(crate) fn prepare(scene: &Scene, code: Code, limits: &crate::limits::Limits) -> Result<Exported, Error> {
     if let GrainShape::Disk { thickness } = scene.grain_shape {
         return Err(fields::refuse(code, "grain_shape.disk.thickness", thickness, ""));
     }
@@ -128,7 +128,7 @@ pub(crate) fn prepare(scene: &Scene, code: Code) -> Result<Exported, Error> {
     {
         return Err(fields::refuse(code, &format!("grains.list[{k}].omega"), g.omega, "model.rotation = false"));
     }
-    let built = build(scene)?;
+    let built = crate::build::build_limited(scene, 1, limits)?;
     let (steps, sample_every) = crate::run::schedule(scene.duration, built.time_step.dt_s, scene.output.samples);
     let e = built.engine.as_ref();
     let n_free = e.particles().n_free;
@@ -255,7 +255,7 @@ pub fn export(scene: &Scene, code: Code, dir: &Path) -> Result<Vec<std::path::Pa
 /// cost the reference code time that grainlab's own timing does not include) and prints
 /// its loop time: LIGGGHTS' `Loop time of ...`, YADE's `grainlab-loop-seconds ...`.
 pub fn export_with(scene: &Scene, code: Code, dir: &Path, bench: bool) -> Result<Vec<std::path::PathBuf>, Error> {
-    let files = export_files(scene, code, bench)?;
+    let files = export_files(scene, code, bench, &crate::limits::Limits::machine())?;
     std::fs::create_dir_all(dir).map_err(|e| Error::io(dir.display(), e))?;
     let mut written = Vec::new();
     for (name, text) in files {
@@ -267,8 +267,8 @@ pub fn export_with(scene: &Scene, code: Code, dir: &Path, bench: bool) -> Result
 }
 
 /// What [`export_with`] writes, as (file name, text), without writing it.
-pub fn export_files(scene: &Scene, code: Code, bench: bool) -> Result<Vec<(&'static str, String)>, Error> {
-    let mut ex = prepare(scene, code)?;
+pub fn export_files(scene: &Scene, code: Code, bench: bool, limits: &crate::limits::Limits) -> Result<Vec<(&'static str, String)>, Error> {
+    let mut ex = prepare(scene, code, limits)?;
     ex.bench = bench;
     let b = bounds(&ex.built, scene.duration);
     let deck = match code {

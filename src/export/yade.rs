@@ -99,7 +99,7 @@ pub(crate) fn deck(scene: &Scene, ex: &Exported) -> Result<String, Error> {
         }
         let range = |k: usize| match &walls[k].surface {
             Surface::Rough { grains } => Ok((grains.start, grains.end)),
-            Surface::Flat => Err(Error::Other("export to yade: the shear export needs rough walls".into())),
+            Surface::Flat => Err(Error::Export("export to yade: the shear export needs rough walls".into())),
         };
         let ((b0, b1), (t0, t1)) = (range(0)?, range(1)?);
         let ys = p.x.iter().map(|x| x.y);
@@ -139,9 +139,7 @@ pub(crate) fn deck(scene: &Scene, ex: &Exported) -> Result<String, Error> {
     }
     for wall in walls {
         if let Surface::Flat = wall.surface {
-            let ws = scene.walls.as_ref().expect("walls");
-            let m = if wall.name == "bottom" { ws.bottom.material } else { ws.top.material };
-            let _ = writeln!(w, "b = O.bodies.append(wall({}, axis=1, sense={}, material=mats[{m}]))", f(wall.y), if wall.side > 0.0 { 1 } else { -1 });
+            let _ = writeln!(w, "b = O.bodies.append(wall({}, axis=1, sense={}, material=mats[{}]))", f(wall.y), if wall.side > 0.0 { 1 } else { -1 }, wall.material);
             let _ = writeln!(w, "O.bodies[b].state.vel = Vector3({}, 0, 0)", f(wall.v.x));
         }
     }

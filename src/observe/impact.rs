@@ -10,6 +10,10 @@ use serde::Serialize;
 use crate::build::Engine;
 use crate::dim::Vec2;
 
+/// The most points the force-overlap curve keeps: a million steps in contact (an impact
+/// at 200 steps per contact time takes about 200).
+pub const MAX_CURVE_POINTS: usize = 1_000_000;
+
 /// One sample of the force-overlap curve.
 #[derive(Clone, Copy, Debug, Serialize, serde::Deserialize)]
 pub struct CurvePoint {
@@ -161,7 +165,11 @@ impl ImpactObserver {
                 self.t_start = Some(tp + (t - tp) * (-cp.overlap) / (c.overlap - cp.overlap));
             }
             if self.t_end.is_none() {
-                self.curve.push(CurvePoint { time_s: t, overlap_m: c.overlap, normal_force_n: c.force });
+                // At most MAX_CURVE_POINTS: a contact longer than that is a grain at rest
+                // on its partner, not an impact, and its first part holds the peaks.
+                if self.curve.len() < MAX_CURVE_POINTS {
+                    self.curve.push(CurvePoint { time_s: t, overlap_m: c.overlap, normal_force_n: c.force });
+                }
             }
         } else if cp.overlap > 0.0 && self.t_end.is_none() {
             self.t_end = Some(tp + (t - tp) * cp.overlap / (cp.overlap - c.overlap));

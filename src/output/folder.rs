@@ -36,6 +36,8 @@ pub const TEMP_SUFFIX: &str = ".grainlab-tmp";
 pub const PART_SUFFIX: &str = ".part";
 /// How many foreign files a refusal names.
 const NAMED: usize = 5;
+/// The most a manifest may weigh, bytes: a million files listed.
+const MAX_MANIFEST_BYTES: u64 = 128 << 20;
 
 /// `manifest.json`: what grainlab wrote in its output folder.
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -147,7 +149,11 @@ fn inspect(dir: &Path, overwrite: bool) -> Result<Clearing, Error> {
     if entries.is_empty() {
         return Ok(nothing);
     }
-    let manifest: Option<Manifest> = std::fs::read_to_string(dir.join(MANIFEST)).ok().and_then(|t| serde_json::from_str(&t).ok()).filter(|m: &Manifest| m.format == FORMAT);
+    // Read only if a regular file of sane size (a pipe named like it would never end).
+    let manifest: Option<Manifest> = crate::limits::read_bounded(&dir.join(MANIFEST), MAX_MANIFEST_BYTES, MANIFEST)
+        .ok()
+        .and_then(|t| serde_json::from_str(&t).ok())
+        .filter(|m: &Manifest| m.format == FORMAT);
     let Some(manifest) = manifest else {
         let names: Vec<String> = entries.iter().map(|e| e.0.clone()).collect();
         return refuse(format!(
@@ -192,8 +198,15 @@ fn inspect(dir: &Path, overwrite: bool) -> Result<Clearing, Error> {
                 continue;
             }
             let path = dir.join(&f.path);
+            // The size first: a file of another size (or no regular file) has changed,
+            // without reading it.
+            let meta = std::fs::metadata(&path).map_err(|e| Error::io(path.display(), e))?;
+            if !meta.is_file() || meta.len() != bytes {
+                changed.push(f.path.clone());
+                continue;
+            }
             let data = std::fs::read(&path).map_err(|e| Error::io(path.display(), e))?;
-            if data.len() as u64 != bytes || crc_hex(crc32fast::hash(&data)) != crc {
+            if crc_hex(crc32fast::hash(&data)) != crc {
                 changed.push(f.path.clone());
             }
         }
