@@ -2,12 +2,12 @@
 //! the neighbour rebuild.
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use grainlab::boundary::Boundary;
+use grainlab::physics::boundary::Boundary;
 use grainlab::build;
-use grainlab::neighbor::cell_pairs;
-use grainlab::threads::Threads;
+use grainlab::kernels::cells::cell_pairs;
+use grainlab::kernels::threads::Threads;
 use grainlab::scene::TangentialSpec;
-use grainlab::scenes::shear;
+use grainlab::scene::builtin::shear;
 
 fn shear_step(c: &mut Criterion) {
     let mut g = c.benchmark_group("shear_step_1000_grains");
@@ -40,11 +40,11 @@ fn neighbour_rebuild(c: &mut Criterion) {
 }
 
 fn contact_kernel(c: &mut Criterion) {
-    use grainlab::contact::model::{LiggghtsHertzHistory, YadeMindlin};
-    use grainlab::contact::{ContactHistory, ContactInput, LeverArm, ModelOptions};
-    use grainlab::dim::Vec2;
-    use grainlab::material::{Material, PairMaterial};
-    use grainlab::observe::energy::EnergyLedger;
+    use grainlab::physics::contact::model::{LiggghtsHertzHistory, YadeMindlin};
+    use grainlab::physics::contact::{ContactHistory, ContactInput, LeverArm, ModelOptions};
+    use grainlab::physics::dim::Vec2;
+    use grainlab::physics::material::{Material, PairMaterial};
+    use grainlab::physics::energy::EnergyLedger;
     use std::hint::black_box;
     // A sticking glass-glass contact of two 0.5 mm beads at a typical shear-cell overlap.
     let pm = PairMaterial::mix(&Material::default(), &Material::default());
@@ -65,7 +65,7 @@ fn contact_kernel(c: &mut Criterion) {
     c.bench_function("contact_kernel_liggghts_history", |b| b.iter(|| l.touch::<false>(black_box(&input), &pm, &mut h, &mut ledger)));
     // Four such contacts at once in SIMD lanes (one iteration = four contacts).
     {
-        use grainlab::lanes::{Lanes, gather, gather2};
+        use grainlab::physics::lanes::{Lanes, gather, gather2};
         use simba::simd::SimdValue;
         let one = [input; 4];
         let lanes = ContactInput {
@@ -79,8 +79,8 @@ fn contact_kernel(c: &mut Criterion) {
             tangential_scale: Lanes::splat(1.0),
         };
         let pml = PairMaterial::gather([&pm; 4]);
-        let xi = grainlab::dim::Vec2::zeros();
-        let mut h = <grainlab::contact::tangential::TotalDisplacement as grainlab::contact::tangential::Tangential>::gather([&xi; 4]);
+        let xi = grainlab::physics::dim::Vec2::zeros();
+        let mut h = <grainlab::physics::contact::tangential::TotalDisplacement as grainlab::physics::contact::tangential::Tangential>::gather([&xi; 4]);
         c.bench_function("contact_kernel_liggghts_history_four_lanes", |b| b.iter(|| l.force(black_box(&lanes), &pml, &mut h)));
     }
     let y = YadeMindlin::new(options);

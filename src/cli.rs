@@ -8,12 +8,13 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use clap::{Parser, Subcommand};
 use grainlab::Error;
-use grainlab::build::build_limited;
+use grainlab::build_limited;
 use grainlab::error::exit;
-use grainlab::limits::Limits;
+use grainlab::scene::limits::Limits;
 use grainlab::output::{csv::CsvSeries, folder::OutFolder};
-use grainlab::run::{RunOptions, RunReport, run_report, run_scene, timing_table};
-use grainlab::scenes::BUILTIN;
+use grainlab::output::summary::timing_table;
+use grainlab::study::run::{RunOptions, RunReport, run_report, run_scene};
+use grainlab::scene::builtin::BUILTIN;
 
 #[derive(Parser)]
 #[command(name = "grainlab", version, about = "A 2D Hertz-Mindlin DEM engine, checked against LIGGGHTS and YADE", after_help = EXIT_CODES)]
@@ -22,7 +23,7 @@ struct Cli {
     command: Command,
     /// Memory a scene may ask for (e.g. 512M, 8G): scenes whose estimate exceeds it are
     /// refused before anything is allocated. Default: half the machine's memory.
-    #[arg(long, global = true, value_parser = grainlab::limits::parse_bytes)]
+    #[arg(long, global = true, value_parser = grainlab::scene::limits::parse_bytes)]
     memory_budget: Option<u64>,
 }
 
@@ -64,7 +65,7 @@ enum Command {
     /// Write an equivalent LIGGGHTS deck or YADE script, the shared particle file and
     /// export.json into a directory.
     Export {
-        code: grainlab::export::Code,
+        code: grainlab::workbench::export::Code,
         #[arg(required_unless_present = "explain_fields")]
         scene: Option<String>,
         /// Output folder: new, empty, or one grainlab wrote (see --overwrite).
@@ -91,7 +92,7 @@ enum Command {
     },
     /// Measure a reference code's raw output (series.txt or walls.txt in RUN_DIR) into
     /// CASE_DIR/expected/CODE/.
-    Digest { case_dir: PathBuf, code: grainlab::export::Code, run_dir: PathBuf },
+    Digest { case_dir: PathBuf, code: grainlab::workbench::export::Code, run_dir: PathBuf },
     /// Run the engine on every committed case and compare it with the reference data.
     Compare {
         #[arg(long, default_value = "reference/cases")]
@@ -187,7 +188,7 @@ macro_rules! note {
 
 fn execute(cli: Cli) -> Result<(), Error> {
     let limits = cli.memory_budget.map_or_else(Limits::machine, Limits::with_memory);
-    let load_scene = |arg: &str| grainlab::scenes::load(arg, &limits);
+    let load_scene = |arg: &str| grainlab::scene::builtin::load(arg, &limits);
     match cli.command {
         Command::Run { scene, out, overwrite, duration, quiet, threads } => {
             let scene = load_scene(&scene)?;
@@ -227,7 +228,7 @@ fn execute(cli: Cli) -> Result<(), Error> {
             }
         }
         Command::Handover { threads, samples } => {
-            say!("{}", serde_json::to_string_pretty(&grainlab::threads::hand_over_summary(threads, samples)?).expect("numbers serialise"))
+            say!("{}", serde_json::to_string_pretty(&grainlab::kernels::threads::hand_over_summary(threads, samples)?).expect("numbers serialise"))
         }
         Command::Explain { scene } => {
             let scene = load_scene(&scene)?;
@@ -235,11 +236,11 @@ fn execute(cli: Cli) -> Result<(), Error> {
         }
         Command::Export { code, scene, out, overwrite, bench, explain_fields } => {
             if explain_fields {
-                return say!("{}", grainlab::export::fields::explain(code).trim_end());
+                return say!("{}", grainlab::workbench::export::fields::explain(code).trim_end());
             }
             let (Some(scene), Some(out)) = (scene, out) else { unreachable!("clap requires SCENE and --out without --explain-fields") };
             let scene = load_scene(&scene)?;
-            let files = grainlab::export::export_files(&scene, code, bench, &limits)?;
+            let files = grainlab::workbench::export::export_files(&scene, code, bench, &limits)?;
             let mut folder = OutFolder::claim(&out, overwrite, &format!("export {} {}", code.name(), scene.name))?;
             for (name, text) in files {
                 folder.write(name, text.as_bytes())?;
@@ -258,7 +259,7 @@ fn execute(cli: Cli) -> Result<(), Error> {
         }
         Command::Compare { root, filter, csv } => compare(&root, filter.as_deref(), csv.as_deref()),
         Command::Sweep { scene, steps, rayleigh, variants, duration, out } => {
-            use grainlab::sweep::{Step, Variant, sweep};
+            use grainlab::study::sweep::{Step, Variant, sweep};
             let scene = load_scene(&scene)?;
             let mut st: Vec<Step> = steps.iter().map(|&n| Step::PerContact(n)).collect();
             st.extend(rayleigh.iter().map(|&f| Step::Rayleigh(f)));

@@ -1,12 +1,13 @@
 //! Accuracy against cost: the sweep, and the accuracy-targeted time step.
 
-use grainlab::accuracy::{AccuracyQuantity, calibrate, ladder};
+use grainlab::scene::AccuracyQuantity;
+use grainlab::study::accuracy::{calibrate, ladder};
 use grainlab::build;
-use grainlab::material::Material;
-use grainlab::run::{RunOptions, run_scene};
+use grainlab::physics::material::Material;
+use grainlab::study::run::{RunOptions, run_scene};
 use grainlab::scene::TimeStepRule;
-use grainlab::scenes::head_on;
-use grainlab::sweep::{Step, Variant, sweep};
+use grainlab::scene::builtin::head_on;
+use grainlab::study::sweep::{Step, Variant, sweep};
 
 fn glass(e: f64) -> Material {
     Material { restitution: e, ..Material::default() }

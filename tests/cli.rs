@@ -299,7 +299,7 @@ fn export_lists_what_a_code_cannot_express() {
         let text = String::from_utf8(out.stdout).unwrap();
         let cannot = text.split("expressed approximately").next().unwrap();
         assert!(cannot.contains("cannot be expressed") && cannot.contains("  model.general_damping:") && cannot.contains(refused), "{code}:\n{text}");
-        for f in grainlab::export::fields::FIELDS {
+        for f in grainlab::workbench::export::fields::FIELDS {
             assert!(text.contains(&format!("  {}", f.path)), "{code}: {} missing", f.path);
         }
     }

@@ -1,5 +1,5 @@
 //! The exporter is exact or refuses by name: every leaf of the scene schema has a decision
-//! for each reference code in src/export/fields.rs, and the exporter keeps it.
+//! for each reference code in src/workbench/export/fields.rs, and the exporter keeps it.
 //!
 //! The schema comes from the scene types themselves (schemars), so a field added to the
 //! scene without a decision fails `every_schema_leaf_has_a_decision_and_no_decision_is_stale`.
@@ -23,8 +23,8 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
 
 use grainlab::Scene;
-use grainlab::export::fields::{self, FIELDS};
-use grainlab::export::{Code, export_files};
+use grainlab::workbench::export::fields::{self, FIELDS};
+use grainlab::workbench::export::{Code, export_files};
 use serde_json::{Value, json};
 
 const CODES: [Code; 2] = [Code::Liggghts, Code::Yade];
@@ -136,8 +136,8 @@ fn every_schema_leaf_has_a_decision_and_no_decision_is_stale() {
     let table: BTreeSet<String> = FIELDS.iter().map(|f| f.path.to_string()).collect();
     let missing: Vec<_> = schema.difference(&table).collect();
     let stale: Vec<_> = table.difference(&schema).collect();
-    assert!(missing.is_empty(), "scene fields without an export decision in src/export/fields.rs: {missing:?}");
-    assert!(stale.is_empty(), "decisions in src/export/fields.rs for no scene field: {stale:?}");
+    assert!(missing.is_empty(), "scene fields without an export decision in src/workbench/export/fields.rs: {missing:?}");
+    assert!(stale.is_empty(), "decisions in src/workbench/export/fields.rs for no scene field: {stale:?}");
     // The walk sees what the issue names, enum variants' fields included.
     for p in ["materials[].restitution", "grains.pack.radius.lognormal.sigma", "walls.top.control.pressure", "time_step.rule.accuracy.tolerance", "grain_shape"] {
         assert!(schema.contains(p), "{p}");
@@ -247,7 +247,7 @@ fn valid(v: &Value) -> Option<Scene> {
 /// 60 steps (long enough for the impacts' contacts to begin, 10.5 steps in).
 fn engine_run(s: &Scene) -> Vec<f64> {
     let mut b = grainlab::build(s).unwrap();
-    let (steps, _) = grainlab::run::schedule(s.duration, b.time_step.dt_s, s.output.samples);
+    let (steps, _) = grainlab::engine::timestep::schedule(s.duration, b.time_step.dt_s, s.output.samples);
     let mut out = vec![b.time_step.dt_s, steps as f64];
     for _ in 0..60 {
         if b.engine.step().is_err() {
@@ -309,18 +309,18 @@ fn json_of(s: &Scene) -> Value {
 }
 
 /// A second material, of restitution `e` (YADE takes one restitution for all pairs).
-fn steel(e: f64) -> grainlab::material::Material {
-    grainlab::material::Material { name: "steel".into(), youngs_modulus: 200e9, poisson_ratio: 0.3, density: 7800.0, restitution: e, friction: 0.3 }
+fn steel(e: f64) -> grainlab::physics::material::Material {
+    grainlab::physics::material::Material { name: "steel".into(), youngs_modulus: 200e9, poisson_ratio: 0.3, density: 7800.0, restitution: e, friction: 0.3 }
 }
 
 fn bases(dir: &Path) -> Vec<Base> {
-    use grainlab::pack::RadiusDist;
+    use grainlab::scene::pack::RadiusDist;
     use grainlab::scene::*;
-    use grainlab::scenes;
-    let collision = scenes::builtin("collision").unwrap();
-    let oblique = scenes::builtin("oblique").unwrap();
+    use grainlab::scene::builtin;
+    let collision = builtin::builtin("collision").unwrap();
+    let oblique = builtin::builtin("oblique").unwrap();
     // 4 mm: YADE's periodic collider needs a cell of at least 4 r_max + 2 r_min (3.2 mm).
-    let mut shear = scenes::shear_cell(60, 0.004);
+    let mut shear = builtin::shear_cell(60, 0.004);
     shear.output.frames = 0;
     let base = |name, s: &Scene| Base { name, scene: json_of(s), only: &[], variant_of: None };
     let focus = |name, s: &Scene, only| Base { name, scene: json_of(s), only, variant_of: None };
@@ -350,7 +350,7 @@ fn bases(dir: &Path) -> Vec<Base> {
         ("collision-fixed", TimeStepRule::Fixed { dt: 0.9 * dt }),
         ("collision-rayleigh", TimeStepRule::RayleighFraction { fraction: 0.1 }),
         ("collision-seed", TimeStepRule::SeedRule { factor: 0.1, reference_overlap: 0.01 }),
-        ("collision-accuracy", TimeStepRule::Accuracy { quantity: grainlab::accuracy::AccuracyQuantity::Restitution, tolerance: 1e-3, impact_speed: 1.0 }),
+        ("collision-accuracy", TimeStepRule::Accuracy { quantity: grainlab::scene::AccuracyQuantity::Restitution, tolerance: 1e-3, impact_speed: 1.0 }),
     ] {
         let mut s = collision.clone();
         s.time_step.rule = rule;
@@ -375,7 +375,7 @@ fn bases(dir: &Path) -> Vec<Base> {
     // The walls' options set: a stress depth, the bottom wall's mass, a second material.
     let mut s = shear.clone();
     let top_mass = grainlab::build(&shear).unwrap().engine.walls()[1].mass;
-    s.materials.push(grainlab::material::Material { name: "glass2".into(), youngs_modulus: 70e9, ..shear.materials[0].clone() });
+    s.materials.push(grainlab::physics::material::Material { name: "glass2".into(), youngs_modulus: 70e9, ..shear.materials[0].clone() });
     let w = s.walls.as_mut().unwrap();
     w.thickness = Some(1e-3);
     w.bottom.mass = Some(top_mass);
@@ -411,7 +411,7 @@ fn bases(dir: &Path) -> Vec<Base> {
     s.gravity = [0.0, -9.81];
     out.push(variant("collision-gravity", &s, "collision", "gravity", &["gravity"]));
     let mut s = collision.clone();
-    s.grain_shape = grainlab::dim::GrainShape::Disk { thickness: 2e-3 };
+    s.grain_shape = grainlab::physics::dim::GrainShape::Disk { thickness: 2e-3 };
     out.push(variant("collision-disk", &s, "collision", "grain_shape", &["grain_shape"]));
     let mut s = collision.clone();
     s.domain.periodic_x = Some([-0.01, 0.01]);
@@ -620,7 +620,7 @@ fn the_exporter_keeps_every_decision() {
         for p in &notes[c] {
             let ok = p == "grains" || fields::field(p).is_some_and(|f| f.decision(code).differs.is_some());
             if !ok {
-                failures.push(format!("{}: a `# Differs: {p}` line, but src/export/fields.rs has no note for {p}", code.name()));
+                failures.push(format!("{}: a `# Differs: {p}` line, but src/workbench/export/fields.rs has no note for {p}", code.name()));
             }
         }
     }
@@ -633,7 +633,7 @@ fn the_exporter_keeps_every_decision() {
 fn one_value_fields_admit_no_other_value() {
     // The bottom wall never carries a load: scene validation refuses it, so the decks'
     // held bottom wall is the only case.
-    let mut s = json_of(&grainlab::scenes::shear_cell(60, 0.004));
+    let mut s = json_of(&grainlab::scene::builtin::shear_cell(60, 0.004));
     s["walls"]["bottom"]["control"] = json!({"pressure": 1e5});
     let e = Scene::from_json(&s.to_string()).expect_err("a loaded bottom wall is refused");
     assert!(e.to_string().contains("walls.bottom.control"), "{e}");
@@ -644,7 +644,7 @@ fn one_value_fields_admit_no_other_value() {
 
 /// Export the collision with `name` for `code`.
 fn named(name: &str, code: Code) -> Vec<(&'static str, String)> {
-    let mut s = grainlab::scenes::builtin("collision").unwrap();
+    let mut s = grainlab::scene::builtin::builtin("collision").unwrap();
     s.name = name.to_string();
     export_files(&s, code, false, &Default::default()).unwrap()
 }
@@ -700,7 +700,7 @@ fn a_silently_dropped_setting_is_caught() {
     // The tests above compare exports with the engine's runs; this is the case the issue
     // found, by hand: general damping changes the engine's run (a drag from the first
     // step), so an export must refuse it by name rather than write the undamped deck.
-    let mut s = grainlab::scenes::builtin("collision").unwrap();
+    let mut s = grainlab::scene::builtin::builtin("collision").unwrap();
     let plain = engine_run(&s);
     s.model.general_damping = Some(100.0);
     assert!(!same_run(&plain, &engine_run(&s)), "general damping does not change the run");

@@ -7,15 +7,15 @@
 //! name the cause.
 
 use assert_cmd::Command;
-use grainlab::limits::Limits;
+use grainlab::scene::limits::Limits;
 use grainlab::scene::Grains;
-use grainlab::scenes::builtin;
+use grainlab::scene::builtin::builtin;
 use grainlab::{Error, Scene};
 use serde_json::{Value, json};
 
 /// The build's refusal of `scene` as text (within a 1 GiB budget).
 fn refusal(scene: &Scene) -> String {
-    match grainlab::build::build_limited(scene, 1, &Limits::with_memory(1 << 30)) {
+    match grainlab::build_limited(scene, 1, &Limits::with_memory(1 << 30)) {
         Ok(_) => panic!("scene `{}` was accepted", scene.name),
         Err(e) => e.to_string(),
     }
@@ -131,7 +131,7 @@ fn grains_far_apart_within_the_bounds_run_in_memory_proportional_to_their_number
         }
         g.push(far);
     }
-    let out = grainlab::run::run_scene(&s, &Default::default()).unwrap();
+    let out = grainlab::study::run::run_scene(&s, &Default::default()).unwrap();
     assert_eq!(out.status, "completed");
 }
 
@@ -229,8 +229,8 @@ fn a_run_that_goes_unstable_stops_with_a_diagnosis_and_finite_outputs() {
     })
     .unwrap();
     let out = dir.path().join("out");
-    let opts = grainlab::run::RunOptions { out: Some(out.clone()), ..Default::default() };
-    let err = grainlab::run::run_scene(&scene, &opts).unwrap_err().to_string();
+    let opts = grainlab::study::run::RunOptions { out: Some(out.clone()), ..Default::default() };
+    let err = grainlab::study::run::run_scene(&scene, &opts).unwrap_err().to_string();
     assert_names(&err, &["run stopped at step", "grain", "stability limit", "time_step.allow_unstable is set"]);
     for f in ["energy.csv", "summary.json"] {
         let text = std::fs::read_to_string(out.join(f)).unwrap().to_ascii_lowercase();
@@ -379,12 +379,12 @@ fn grain_files_declare_their_columns_and_resolve_against_the_scene_file() {
 fn a_scene_that_fits_the_budget_runs_and_one_that_does_not_names_the_budget_flag() {
     // New: the budget itself.
     let s = builtin("shear").unwrap();
-    let msg = match grainlab::build::build_limited(&s, 1, &Limits::with_memory(1 << 20)) {
+    let msg = match grainlab::build_limited(&s, 1, &Limits::with_memory(1 << 20)) {
         Err(e) => e.to_string(),
         Ok(_) => panic!("1000 grains in 1 MiB"),
     };
     assert_names(&msg, &["grains.pack.count = 1000", "memory budget of 1.0 MiB", "--memory-budget"]);
-    assert!(grainlab::build::build_limited(&s, 1, &Limits::with_memory(64 << 20)).is_ok());
+    assert!(grainlab::build_limited(&s, 1, &Limits::with_memory(64 << 20)).is_ok());
     // The flag reaches the build.
     let out = Command::cargo_bin("grainlab").unwrap().args(["explain", "shear", "--memory-budget", "1M"]).output().unwrap();
     assert!(!out.status.success());

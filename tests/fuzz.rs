@@ -16,8 +16,8 @@ use std::alloc::{GlobalAlloc, Layout, System};
 use std::path::Path;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-use grainlab::limits::Limits;
-use grainlab::run::{RunOptions, run_report};
+use grainlab::scene::limits::Limits;
+use grainlab::study::run::{RunOptions, run_report};
 use grainlab::{Error, Scene};
 use proptest::prelude::*;
 use rand::{Rng, SeedableRng};
@@ -71,14 +71,14 @@ const STEPS: f64 = 300.0;
 
 /// The base scenes, as JSON.
 fn bases(dir: &Path) -> Vec<Value> {
-    use grainlab::scenes;
+    use grainlab::scene::builtin;
     let json = |s: &Scene| serde_json::to_value(s).unwrap();
-    let mut out: Vec<Value> = ["collision", "oblique"].iter().map(|n| json(&scenes::builtin(n).unwrap())).collect();
+    let mut out: Vec<Value> = ["collision", "oblique"].iter().map(|n| json(&builtin::builtin(n).unwrap())).collect();
     // The seed's shear cell, smaller (200 grains), so that a case takes milliseconds.
-    let mut shear = scenes::shear_cell(200, 0.008);
+    let mut shear = builtin::shear_cell(200, 0.008);
     shear.output.frames = 3;
     out.push(json(&shear));
-    let mut pair = json(&scenes::oblique_pair(grainlab::material::Material::default(), 1e-3, 1.0, 30.0, grainlab::scene::TangentialSpec::IncrementalForce, 50.0));
+    let mut pair = json(&builtin::oblique_pair(grainlab::physics::material::Material::default(), 1e-3, 1.0, 30.0, grainlab::scene::TangentialSpec::IncrementalForce, 50.0));
     pair["model"]["limit_force"] = true.into();
     pair["gravity"] = json!([0.0, -9.81]);
     out.push(pair);
@@ -90,20 +90,20 @@ fn bases(dir: &Path) -> Vec<Value> {
     flat["grains"]["pack"]["radius"] = json!({"lognormal": {"median": 5e-4, "sigma": 0.1, "min": 4e-4, "max": 6e-4}});
     flat["model"]["general_damping"] = json!(50.0);
     out.push(flat);
-    let mut accurate = json(&scenes::builtin("collision").unwrap());
+    let mut accurate = json(&builtin::builtin("collision").unwrap());
     accurate["time_step"]["rule"] = json!({"accuracy": {"quantity": "peak_force", "tolerance": 1e-2, "impact_speed": 1.0}});
     accurate["grain_shape"] = json!({"disk": {"thickness": 1e-3}});
     out.push(accurate);
     // Grains from a file.
     let file = dir.join("grains.txt");
     std::fs::write(&file, "# x y z r\n0 0.002 0 0.001\n0.0025 0.002 0 0.001\n0.005 0.002 0 0.001\n").unwrap();
-    let mut from_file = json(&scenes::builtin("oblique").unwrap());
+    let mut from_file = json(&builtin::builtin("oblique").unwrap());
     from_file["grains"] = json!({"file": {"path": file.to_str().unwrap(), "columns": "x y z r"}});
     from_file["analysis"] = "none".into();
     from_file["gravity"] = json!([0.0, -9.81]);
     from_file["time_step"]["rule"] = json!({"rayleigh_fraction": {"fraction": 0.2}});
     out.push(from_file);
-    let mut seed = json(&scenes::builtin("collision").unwrap());
+    let mut seed = json(&builtin::builtin("collision").unwrap());
     seed["time_step"]["rule"] = json!({"seed_rule": {"factor": 0.1, "reference_overlap": 0.01}});
     seed["domain"]["periodic_x"] = json!([-0.01, 0.01]);
     seed["materials"].as_array_mut().unwrap().push(json!({"name": "steel", "youngs_modulus": 2e11, "poisson_ratio": 0.3, "density": 7800.0, "restitution": 0.8, "friction": 0.2}));
@@ -296,7 +296,7 @@ fn exercise(text: &str, dir: &Path, export: bool, tally: &mut Tally, case: &str)
     let file = dir.join("scene.json");
     std::fs::write(&file, text).unwrap();
     let limits = Limits::with_memory(BUDGET);
-    let scene = match grainlab::scenes::load(file.to_str().unwrap(), &limits) {
+    let scene = match grainlab::scene::builtin::load(file.to_str().unwrap(), &limits) {
         Ok(s) => s,
         Err(e) => {
             tally.parse += 1;
@@ -309,7 +309,7 @@ fn exercise(text: &str, dir: &Path, export: bool, tally: &mut Tally, case: &str)
             return Ok(());
         }
     };
-    let built = match grainlab::build::build_limited(&scene, 1, &limits) {
+    let built = match grainlab::build_limited(&scene, 1, &limits) {
         Ok(b) => b,
         Err(e) => {
             tally.refused += 1;
@@ -340,8 +340,8 @@ fn exercise(text: &str, dir: &Path, export: bool, tally: &mut Tally, case: &str)
     }
     assert_files_finite(&out);
     if export {
-        for code in [grainlab::export::Code::Liggghts, grainlab::export::Code::Yade] {
-            match grainlab::export::export_files(&scene, code, false, &limits) {
+        for code in [grainlab::workbench::export::Code::Liggghts, grainlab::workbench::export::Code::Yade] {
+            match grainlab::workbench::export::export_files(&scene, code, false, &limits) {
                 Ok(files) => {
                     tally.exported += 1;
                     for (name, text) in files {
@@ -387,7 +387,7 @@ fn mutated_scenes_are_refused_by_name_or_run_to_a_finite_end_within_budget() {
     // Every base runs as it is.
     let mut tally = Tally::default();
     for (k, b) in bases.iter().enumerate() {
-        let built = Scene::from_json(&b.to_string()).and_then(|s| grainlab::build::build_limited(&s, 1, &Limits::with_memory(BUDGET)).map(|_| ()));
+        let built = Scene::from_json(&b.to_string()).and_then(|s| grainlab::build_limited(&s, 1, &Limits::with_memory(BUDGET)).map(|_| ()));
         assert!(built.is_ok(), "base {k}: {built:?}");
         exercise(&b.to_string(), dir.path(), true, &mut tally, "base").unwrap();
     }

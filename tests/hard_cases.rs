@@ -4,15 +4,16 @@
 //! energy created beyond the integrator's error, Coulomb's law, and bounded overlaps,
 //! with the reason for each bound.
 
-use grainlab::contact::LeverArm;
-use grainlab::dim::Vec2;
+use grainlab::physics::contact::LeverArm;
+use grainlab::physics::dim::Vec2;
 use grainlab::error::Error;
-use grainlab::material::{Material, PairMaterial, hertz_max_overlap};
+use grainlab::physics::material::{Material, PairMaterial, hertz_max_overlap};
 use grainlab::observe::impact::ImpactSummary;
-use grainlab::pack::RadiusDist;
-use grainlab::run::{RunOptions, Summary, run_scene};
+use grainlab::scene::pack::RadiusDist;
+use grainlab::output::summary::Summary;
+use grainlab::study::run::{RunOptions, run_scene};
 use grainlab::scene::*;
-use grainlab::scenes::{head_on, oblique, shear};
+use grainlab::scene::builtin::{head_on, oblique, shear};
 use grainlab::{Engine, build};
 
 const R: f64 = 1e-3;

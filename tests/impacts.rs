@@ -1,9 +1,9 @@
 //! Head-on impacts against closed-form Hertz theory and conservation laws.
 
-use grainlab::material::{Material, PairMaterial, hertz_contact_time, hertz_max_overlap};
+use grainlab::physics::material::{Material, PairMaterial, hertz_contact_time, hertz_max_overlap};
 use grainlab::observe::impact::ImpactSummary;
-use grainlab::run::{RunOptions, run_scene};
-use grainlab::scenes::head_on;
+use grainlab::study::run::{RunOptions, run_scene};
+use grainlab::scene::builtin::head_on;
 
 const R: f64 = 1e-3;
 
@@ -122,7 +122,7 @@ fn a_sliding_oblique_impact_obeys_coulomb_exactly() {
     // impulse, so the tangential velocity change is mu times the normal one and the spin
     // is m r dv_t / I, for both tangential formulations, to round-off.
     use grainlab::scene::TangentialSpec;
-    use grainlab::scenes::oblique;
+    use grainlab::scene::builtin::oblique;
     for t in [TangentialSpec::TotalDisplacement, TangentialSpec::IncrementalForce] {
         let mut g = glass(0.9);
         g.friction = 0.1;

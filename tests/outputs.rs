@@ -395,12 +395,12 @@ fn each_class_of_failure_has_its_exit_code() {
 /// back with the I/O error, everything else is written, and the manifest says so.
 #[test]
 fn a_stopped_run_returns_its_summary_when_summary_json_cannot_be_written() {
-    use grainlab::run::{RunOptions, run_report};
+    use grainlab::study::run::{RunOptions, run_report};
     use std::sync::Arc;
     use std::sync::atomic::{AtomicBool, Ordering};
     let tmp = tempfile::tempdir().unwrap();
     let out = tmp.path().join("out");
-    let scene = grainlab::scenes::builtin("shear").unwrap();
+    let scene = grainlab::scene::builtin::builtin("shear").unwrap();
     let built = grainlab::build(&scene).unwrap();
     let stop = Arc::new(AtomicBool::new(false));
     let opts = RunOptions { out: Some(out.clone()), stop: Some(stop.clone()), ..RunOptions::default() };

@@ -3,7 +3,7 @@
 
 use grainlab::build_with;
 use grainlab::scene::TangentialSpec;
-use grainlab::scenes::shear_cell;
+use grainlab::scene::builtin::shear_cell;
 
 /// A sheared dense packing stepped on one thread and on `threads`, for `steps` steps:
 /// the same bits for every grain and for the energy ledger.
@@ -53,7 +53,7 @@ fn three_threads_give_the_same_bits_as_one() {
 
 #[test]
 fn the_pool_gives_every_grain_once_keeps_parts_on_their_threads_and_passes_panics_on() {
-    use grainlab::threads::Threads;
+    use grainlab::kernels::threads::Threads;
     use std::panic::{AssertUnwindSafe, catch_unwind};
     use std::sync::Mutex;
     let t = Threads::new(2).unwrap();
@@ -103,7 +103,7 @@ fn the_pool_gives_every_grain_once_keeps_parts_on_their_threads_and_passes_panic
 
 #[test]
 fn the_hand_over_probe_times_every_sample_and_checks_its_input() {
-    use grainlab::threads::hand_over_summary;
+    use grainlab::kernels::threads::hand_over_summary;
     let h = hand_over_summary(2, 500).unwrap();
     assert_eq!((h.threads, h.samples), (2, 500));
     // Ordered quantiles of positive times. A hand-over with no work is a store and a spin
@@ -124,8 +124,8 @@ fn the_hand_over_probe_times_every_sample_and_checks_its_input() {
 /// finding its place in the old list by bisection.
 #[test]
 fn two_threads_rebuild_the_pair_list_as_one() {
-    use grainlab::neighbor::PairList;
-    use grainlab::threads::Threads;
+    use grainlab::kernels::pairs::PairList;
+    use grainlab::kernels::threads::Threads;
     use rand::{Rng, SeedableRng};
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
     let n = 3000;

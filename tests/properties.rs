@@ -1,10 +1,10 @@
 //! Property tests: the cell list finds exactly the pairs brute force finds, and the
 //! four-lane contact kernel gives each contact the bits the one-contact kernel gives it.
 
-use grainlab::boundary::Boundary;
-use grainlab::dim::Vec2;
-use grainlab::neighbor::{brute_force_pairs, cell_pairs};
-use grainlab::threads::Threads;
+use grainlab::physics::boundary::Boundary;
+use grainlab::physics::dim::Vec2;
+use grainlab::kernels::cells::{brute_force_pairs, cell_pairs};
+use grainlab::kernels::threads::Threads;
 use proptest::prelude::*;
 
 fn packing() -> impl Strategy<Value = (Vec<Vec2>, Vec<f64>, usize, bool, f64)> {
@@ -64,17 +64,17 @@ fn contact() -> impl Strategy<Value = [f64; 9]> {
         .prop_map(|(dn, a, vx, vy, w, hx, hy, b, rs)| [10f64.powf(dn) * 5e-4, a, vx, vy, 1e3 * w, hx, hy, b, rs])
 }
 
-fn lanes_match_alone<T: grainlab::contact::tangential::Tangential>(
+fn lanes_match_alone<T: grainlab::physics::contact::tangential::Tangential>(
     cs: &[[f64; 9]; 4],
     limit_force: bool,
-    lever_arm: grainlab::contact::LeverArm,
+    lever_arm: grainlab::physics::contact::LeverArm,
     hist: impl Fn(&[f64; 9]) -> T::History<f64>,
     bits: impl Fn(&T::History<f64>) -> Vec<u64>,
 ) -> Result<(), TestCaseError> {
-    use grainlab::contact::damping::Viscoelastic;
-    use grainlab::contact::{ContactInput, ContactModel, ModelOptions};
-    use grainlab::lanes::{Lanes, gather, gather2, lane2};
-    use grainlab::material::{Material, PairMaterial};
+    use grainlab::physics::contact::damping::Viscoelastic;
+    use grainlab::physics::contact::{ContactInput, ContactModel, ModelOptions};
+    use grainlab::physics::lanes::{Lanes, gather, gather2, lane2};
+    use grainlab::physics::material::{Material, PairMaterial};
     use simba::simd::SimdValue;
     let model = ContactModel::<Viscoelastic, T>::new(ModelOptions { limit_force, lever_arm });
     let pm = PairMaterial::mix(&Material::default(), &Material::default());
@@ -115,7 +115,7 @@ fn lanes_match_alone<T: grainlab::contact::tangential::Tangential>(
         prop_assert_eq!(bits(&T::lane(&h, l)), bits(&alone[l].1), "lane {} history", l);
     }
     // The energy terms, from a made-up previous step, likewise.
-    use grainlab::contact::{EnergyMemory, EnergyTerms};
+    use grainlab::physics::contact::{EnergyMemory, EnergyTerms};
     let memory = |c: &[f64; 9]| EnergyMemory { fd_prev: c[2], fte_prev: Vec2::new(c[5], c[6]) * 1e3, ftd_prev: Vec2::new(c[3], c[4]), ut_prev: 1e-9 * c[8] };
     let term_bits = |t: &EnergyTerms| [t.normal_damping, t.elastic_normal, t.tangential_damping, t.friction, t.tangential_model, t.elastic_tangential].map(f64::to_bits);
     let mem_bits = |m: &EnergyMemory| [m.fd_prev, m.fte_prev.x, m.fte_prev.y, m.ftd_prev.x, m.ftd_prev.y, m.ut_prev].map(f64::to_bits);
@@ -135,8 +135,8 @@ proptest! {
     #![proptest_config(ProptestConfig::with_cases(300))]
     #[test]
     fn four_lanes_give_each_contact_its_own_bits(c0 in contact(), c1 in contact(), c2 in contact(), c3 in contact(), clamp in any::<bool>(), lever in 0usize..3) {
-        use grainlab::contact::LeverArm;
-        use grainlab::contact::tangential::{IncrementalForce, IncrementalState, TotalDisplacement};
+        use grainlab::physics::contact::LeverArm;
+        use grainlab::physics::contact::tangential::{IncrementalForce, IncrementalState, TotalDisplacement};
         let lever = [LeverArm::Radius, LeverArm::RadiusMinusHalfOverlap, LeverArm::Yade][lever];
         let cs = [c0, c1, c2, c3];
         let v = |v: &Vec2| vec![v.x.to_bits(), v.y.to_bits()];

@@ -1,8 +1,8 @@
 //! The shear cell: energy balance and the confining stress.
 
-use grainlab::run::{RunOptions, run_scene};
+use grainlab::study::run::{RunOptions, run_scene};
 use grainlab::scene::ControlSpec;
-use grainlab::scenes::shear;
+use grainlab::scene::builtin::shear;
 
 #[test]
 fn energy_balance_closes_in_a_short_shear_run() {

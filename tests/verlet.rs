@@ -3,8 +3,8 @@
 //! finds every touching pair among the listed ones.
 
 use grainlab::build_with;
-use grainlab::neighbor::brute_force_pairs;
-use grainlab::scenes::shear_cell;
+use grainlab::kernels::cells::brute_force_pairs;
+use grainlab::scene::builtin::shear_cell;
 
 #[test]
 fn every_touching_pair_is_in_the_list_at_every_step() {

@@ -1,9 +1,9 @@
 //! Walls and gravity: a grain comes to rest on a flat wall.
 
-use grainlab::material::Material;
-use grainlab::run::{RunOptions, run_built};
+use grainlab::physics::material::Material;
+use grainlab::study::run::{RunOptions, run_built};
 use grainlab::scene::{Analysis, TangentialSpec};
-use grainlab::scenes::oblique;
+use grainlab::scene::builtin::oblique;
 
 #[test]
 fn a_grain_settles_on_a_flat_wall_under_gravity() {
@@ -40,7 +40,7 @@ fn a_grain_settles_on_a_flat_wall_under_gravity() {
 /// had used the top wall's material for both walls: e = 0.9 and the glass contact time.)
 #[test]
 fn each_flat_wall_contacts_with_its_own_material() {
-    use grainlab::material::{PairMaterial, hertz_contact_time};
+    use grainlab::physics::material::{PairMaterial, hertz_contact_time};
     let glass = Material { restitution: 0.9, ..Material::default() };
     let soft = Material { name: "soft".into(), youngs_modulus: 6.3e8, restitution: 0.3, ..Material::default() };
     let impact_on_bottom = |bead: &Material, bottom: &Material| {

@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use grainlab::export::Code;
+use grainlab::workbench::export::Code;
 use grainlab::workbench::*;
 
 fn root() -> PathBuf {

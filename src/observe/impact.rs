@@ -7,12 +7,12 @@
 
 use serde::Serialize;
 
-use crate::build::Engine;
-use crate::dim::Vec2;
+use crate::engine::world::View;
+use crate::physics::dim::Vec2;
 
-/// The most points the force-overlap curve keeps: a million steps in contact (an impact
-/// at 200 steps per contact time takes about 200).
-pub const MAX_CURVE_POINTS: usize = 1_000_000;
+/// The most points the force-overlap curve keeps (a cap of the scene's limits, which the
+/// build's memory estimate counts too).
+pub use crate::scene::limits::MAX_CURVE_POINTS;
 
 /// One sample of the force-overlap curve.
 #[derive(Clone, Copy, Debug, Serialize, serde::Deserialize)]
@@ -86,7 +86,7 @@ pub struct ImpactState {
     /// Grain 0 against a flat wall `(y, side, velocity)` instead of grain 1.
     pub wall: Option<(f64, f64, Vec2)>,
     /// Periodicity, for the pair's separation vector.
-    pub boundary: crate::boundary::Boundary,
+    pub boundary: crate::physics::boundary::Boundary,
     /// Total momentum of the free grains, kg m/s (two-grain impacts).
     pub momentum: Vec2,
     /// Sum of m |v| over the free grains, kg m/s.
@@ -95,23 +95,23 @@ pub struct ImpactState {
 
 impl ImpactState {
     /// The state of a running engine.
-    pub fn of(e: &dyn Engine) -> ImpactState {
-        let p = e.particles();
+    pub fn of(e: &View) -> ImpactState {
+        let p = e.particles;
         let two = p.n_free >= 2;
         let j = if two { 1 } else { 0 };
         let wall = (!two).then(|| {
-            let w = e.walls().iter().find(|w| w.is_flat()).expect("an impact scene has two grains or a flat wall");
+            let w = e.walls.iter().find(|w| w.is_flat()).expect("an impact scene has two grains or a flat wall");
             (w.y, w.side, w.v)
         });
         ImpactState {
-            time: e.time(),
+            time: e.time,
             x: [p.x[0], p.x[j]],
             v: [p.v[0], p.v[j]],
             omega: [p.omega[0], p.omega[j]],
             r: [p.r[0], p.r[j]],
             f0: p.f[0],
             wall,
-            boundary: e.boundary(),
+            boundary: e.boundary,
             momentum: p.momentum(),
             momentum_scale: (0..p.n_free).map(|i| p.m[i] * p.v[i].norm()).sum::<f64>(),
         }
@@ -137,7 +137,7 @@ impl ImpactState {
 
 impl ImpactObserver {
     /// Call once before the first step.
-    pub fn start(&mut self, e: &dyn Engine) {
+    pub fn start(&mut self, e: &View) {
         self.start_state(&ImpactState::of(e));
     }
 
@@ -148,7 +148,7 @@ impl ImpactObserver {
     }
 
     /// Call after every step.
-    pub fn observe(&mut self, e: &dyn Engine) {
+    pub fn observe(&mut self, e: &View) {
         self.observe_state(&ImpactState::of(e));
     }
 

@@ -1,5 +1,8 @@
-//! What a run measures: the energy balance, impacts, wall stresses.
+//! What a run measures, from a read-only view of the state ([`crate::engine::world::View`]):
+//! the energy balance's summary, impacts, wall stresses, block-averaged statistics.
+//! May use: `engine` (its view and time step), `physics`, `scene`, `error`.
 
 pub mod energy;
 pub mod impact;
+pub mod stats;
 pub mod stress;

@@ -10,8 +10,9 @@
 
 use serde::Serialize;
 
-use crate::build::Engine;
-use crate::dim::Vec2;
+use crate::engine::world::View;
+use crate::observe::stats::{Estimate, block_average};
+use crate::physics::dim::Vec2;
 
 /// One row of the wall time series (forces averaged over the sample interval).
 #[derive(Clone, Copy, Debug, Default, Serialize, serde::Deserialize)]
@@ -36,8 +37,8 @@ pub struct WallAverager {
 }
 
 impl WallAverager {
-    pub fn accumulate(&mut self, e: &dyn Engine) {
-        let w = e.walls();
+    pub fn accumulate(&mut self, e: &View) {
+        let w = e.walls;
         if w.len() == 2 {
             self.sum[0] += w[0].force;
             self.sum[1] += w[1].force;
@@ -45,14 +46,14 @@ impl WallAverager {
         }
     }
     /// The row for the interval just finished; restarts the averages.
-    pub fn row(&mut self, e: &dyn Engine, length: f64, depth: f64) -> Option<WallRow> {
-        let w = e.walls();
+    pub fn row(&mut self, e: &View, length: f64, depth: f64) -> Option<WallRow> {
+        let w = e.walls;
         if w.len() != 2 || self.n == 0 {
             return None;
         }
         let (b, t) = (self.sum[0] / self.n as f64, self.sum[1] / self.n as f64);
         *self = WallAverager::default();
-        Some(WallRow::new(e.time(), b, t, w[1].y - w[0].y, length, depth))
+        Some(WallRow::new(e.time, b, t, w[1].y - w[0].y, length, depth))
     }
 }
 
@@ -80,5 +81,38 @@ impl WallRow {
             normal_stress_pa: sigma,
             stress_ratio: ratio(tau, sigma),
         }
+    }
+}
+
+/// The time averages of a shear run's wall stresses.
+#[derive(Clone, Debug, Serialize, serde::Deserialize)]
+pub struct ShearSummary {
+    /// Time from which averages are taken (second half of the run), s.
+    pub averaged_from_s: f64,
+    pub shear_stress_pa: Estimate,
+    pub normal_stress_pa: Estimate,
+    /// Effective friction tau/sigma (block averages of the ratio series, over the rows
+    /// where it is defined); `null` when fewer than two rows have a normal stress.
+    pub stress_ratio: Option<Estimate>,
+    /// 2D packing fraction at the end (free grains' disk area over the gap area); not
+    /// known for a reference code's wall output.
+    pub packing_fraction: Option<f64>,
+}
+
+/// Time averages of the wall stresses over the second half of a wall series, in 10
+/// blocks (the same estimator for the engine and for the reference codes' output).
+pub fn stress_estimates(rows: &[WallRow], packing_fraction: Option<f64>) -> ShearSummary {
+    let half = &rows[rows.len() / 2..];
+    let col = |f: fn(&WallRow) -> f64| half.iter().map(f).collect::<Vec<f64>>();
+    let blocks = 10.min(half.len());
+    ShearSummary {
+        averaged_from_s: half[0].time_s,
+        shear_stress_pa: block_average(&col(|r| r.shear_stress_pa), blocks),
+        normal_stress_pa: block_average(&col(|r| r.normal_stress_pa), blocks),
+        stress_ratio: {
+            let defined: Vec<f64> = half.iter().filter_map(|r| r.stress_ratio).collect();
+            (defined.len() >= 2).then(|| block_average(&defined, 10.min(defined.len())))
+        },
+        packing_fraction,
     }
 }

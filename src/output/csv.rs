@@ -9,7 +9,16 @@ use std::path::{Path, PathBuf};
 use serde::Serialize;
 
 use crate::error::Error;
-use crate::output::folder::{PART_SUFFIX, with_suffix};
+
+/// The end of a streamed series' name while the command goes.
+pub const PART_SUFFIX: &str = ".part";
+
+/// `path` with `suffix` appended to its file name.
+pub fn with_suffix(path: &Path, suffix: &str) -> PathBuf {
+    let mut s = path.as_os_str().to_owned();
+    s.push(suffix);
+    PathBuf::from(s)
+}
 
 /// A writer that counts and checksums what goes through it (the manifest's size and
 /// CRC-32, without reading the file again).

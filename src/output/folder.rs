@@ -24,6 +24,7 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use crate::error::Error;
+pub use crate::output::csv::{PART_SUFFIX, with_suffix};
 use crate::output::csv::CsvSeries;
 
 /// The manifest's file name in the output folder.
@@ -32,8 +33,6 @@ pub const MANIFEST: &str = "manifest.json";
 pub const FORMAT: &str = "grainlab-output-folder/1";
 /// The end of a whole file's name while it is written ([`write_atomic`]).
 pub const TEMP_SUFFIX: &str = ".grainlab-tmp";
-/// The end of a streamed series' name while the command goes.
-pub const PART_SUFFIX: &str = ".part";
 /// How many foreign files a refusal names.
 const NAMED: usize = 5;
 /// The most a manifest may weigh, bytes: a million files listed.
@@ -84,13 +83,6 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), Error> {
         let _ = std::fs::remove_file(&tmp);
         Error::io(path.display(), e)
     })
-}
-
-/// `path` with `suffix` appended to its file name.
-pub fn with_suffix(path: &Path, suffix: &str) -> PathBuf {
-    let mut s = path.as_os_str().to_owned();
-    s.push(suffix);
-    PathBuf::from(s)
 }
 
 /// CRC-32 as the manifest writes it.
@@ -150,7 +142,7 @@ fn inspect(dir: &Path, overwrite: bool) -> Result<Clearing, Error> {
         return Ok(nothing);
     }
     // Read only if a regular file of sane size (a pipe named like it would never end).
-    let manifest: Option<Manifest> = crate::limits::read_bounded(&dir.join(MANIFEST), MAX_MANIFEST_BYTES, MANIFEST)
+    let manifest: Option<Manifest> = crate::scene::limits::read_bounded(&dir.join(MANIFEST), MAX_MANIFEST_BYTES, MANIFEST)
         .ok()
         .and_then(|t| serde_json::from_str(&t).ok())
         .filter(|m: &Manifest| m.format == FORMAT);

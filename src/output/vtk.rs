@@ -4,7 +4,7 @@
 
 use std::fmt::Write as _;
 
-use crate::build::Engine;
+use crate::engine::world::View;
 use crate::error::Error;
 use crate::output::folder::OutFolder;
 
@@ -29,14 +29,14 @@ impl VtkSeries {
 
     /// Write one frame and rewrite the `.pvd` index (each a whole file, listed in the
     /// folder's manifest).
-    pub fn frame(&mut self, e: &dyn Engine, folder: &mut OutFolder) -> Result<(), Error> {
-        let p = e.particles();
+    pub fn frame(&mut self, e: &View, folder: &mut OutFolder) -> Result<(), Error> {
+        let p = e.particles;
         let n = p.len();
         // The last line of defence (the run checks the state before a frame): no frame
         // holds a number that is not finite.
-        let finite = |v: &crate::dim::Vec2| v.x.is_finite() && v.y.is_finite();
+        let finite = |v: &crate::physics::dim::Vec2| v.x.is_finite() && v.y.is_finite();
         if let Some(i) = (0..n).find(|&i| !(finite(&p.x[i]) && finite(&p.v[i]) && finite(&p.f[i]) && p.omega[i].is_finite())) {
-            return Err(Error::Other(format!("frame at t = {:e} s not written: grain {i}'s state is not finite", e.time())));
+            return Err(Error::Other(format!("frame at t = {:e} s not written: grain {i}'s state is not finite", e.time)));
         }
         let mut s = String::with_capacity(200 * n + 1000);
         s.push_str("<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"0.1\" byte_order=\"LittleEndian\">\n  <PolyData>\n");
@@ -62,7 +62,7 @@ impl VtkSeries {
         s.push_str("\n        </DataArray>\n      </Verts>\n    </Piece>\n  </PolyData>\n</VTKFile>\n");
         let name = format!("frames/grains_{:05}.vtp", self.frames.len());
         folder.write(&name, s.as_bytes())?;
-        self.frames.push((e.time(), name));
+        self.frames.push((e.time, name));
         let mut pvd = String::from("<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n  <Collection>\n");
         for (t, f) in &self.frames {
             let _ = writeln!(pvd, "    <DataSet timestep=\"{t:e}\" part=\"0\" file=\"{f}\"/>");

@@ -1,0 +1,476 @@
+//! From a scene to a running engine: grains, walls, time step, contact model, pipeline.
+
+use crate::engine::consistency::{self, GrainNames, MAX_PACKING_OVERLAP, MAX_START_OVERLAP, MAX_STEP_MOVE};
+use crate::engine::domain::{Context, Domain};
+use crate::engine::integrate::{FinalIntegrate, InitialIntegrate};
+use crate::engine::neighbor::Neighbours;
+use crate::engine::simulation::{Engine, Simulation};
+use crate::engine::stages::*;
+use crate::engine::timestep::{RefContact, TimeStepInfo, choose};
+use crate::engine::world::World;
+use crate::error::{Error, Shown};
+use crate::kernels::pairs::PairList;
+use crate::physics::boundary::Boundary;
+use crate::physics::contact::damping::Damping;
+use crate::physics::contact::model::*;
+use crate::physics::contact::tangential::Tangential;
+use crate::physics::contact::{ContactHistory, ContactModel, ModelOptions};
+use crate::physics::dim::Vec2;
+use crate::physics::energy::EnergyLedger;
+use crate::physics::material::{PairMaterial, PairTable};
+use crate::physics::particles::Particles;
+use crate::physics::walls::{Control, Surface, Wall};
+use crate::scene::grains::read_grain_file;
+use crate::scene::limits::{Limits, MemoryEstimate};
+use crate::scene::pack::relaxed_packing;
+use crate::scene::{Analysis, ControlSpec, Grains, Scene, SurfaceSpec, TangentialSpec, TimeStepRule};
+
+/// What was built, besides the engine.
+pub struct Built {
+    pub engine: Box<dyn Engine>,
+    pub time_step: TimeStepInfo,
+    /// Depth that turns wall forces into stresses, m.
+    pub depth: f64,
+    /// Length of the periodic cell (or of the packing), m.
+    pub length: f64,
+}
+
+impl Built {
+    /// The pipeline in one line, with dt and steps per contact.
+    pub fn explain(&self) -> String {
+        let ts = &self.time_step;
+        let mut parts = self.engine.stage_names();
+        if let Some(c) = parts.iter_mut().find(|s| s.as_str() == "PairContacts") {
+            *c = self.engine.model();
+        }
+        parts.retain(|s| s != "ClearForces" && s != "FinalKick");
+        let accuracy = match ts.accuracy {
+            Some(a) => format!(
+                "; chosen for {} <= {:e}: measured {:.2e} against a converged head-on impact",
+                a.quantity.name(),
+                a.tolerance,
+                a.measured_error
+            ),
+            None => String::new(),
+        };
+        format!(
+            "{} (dt = {:.3e} s = t_c/{:.1}, t_c = {:.3e} s at {} m/s; stability limit {:.3e} s{accuracy})",
+            parts.join(" -> "),
+            ts.dt_s,
+            ts.steps_per_contact,
+            ts.contact_time_s,
+            ts.characteristic_speed_m_s,
+            ts.stability_limit_s
+        )
+    }
+}
+
+/// Build the engine a scene describes.
+pub fn build(scene: &Scene) -> Result<Built, Error> {
+    build_with(scene, 1)
+}
+
+/// Build with the contact forces on `threads` threads (feature `parallel`; results are
+/// bit-identical to one thread), within the machine's default [`Limits`].
+pub fn build_with(scene: &Scene, threads: usize) -> Result<Built, Error> {
+    build_limited(scene, threads, &Limits::machine())
+}
+
+/// The number of grains a rough wall of glued grains of `radius` holds over `length`.
+fn glued_count(length: f64, radius: f64) -> f64 {
+    (length / (2.0 * radius)).floor().max(1.0)
+}
+
+/// Build within `limits`: every size is estimated from the scene and checked against the
+/// memory budget before it is allocated, and the grains, walls and time step are checked
+/// for consistency ([`crate::engine::consistency`]) before the engine is.
+pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<Built, Error> {
+    crate::kernels::threads::Threads::check_count(threads, 1)?;
+    scene.validate()?;
+    let shape = scene.grain_shape;
+    let mats = &scene.materials;
+    let boundary = match scene.domain.periodic_x {
+        Some([a, b]) => Boundary::periodic_x(a, b - a),
+        None => Boundary::open(),
+    };
+    // How many grains, before any is made: a file is read (within the budget's file
+    // size) to count them.
+    let file = match &scene.grains {
+        Grains::File { path, columns, .. } => Some(read_grain_file(path, *columns, limits)?),
+        _ => None,
+    };
+    let (count, count_field, count_value) = match &scene.grains {
+        Grains::List(list) => (list.len() as u64, "grains.list".to_string(), format!("{} grains", list.len())),
+        Grains::File { path, .. } => (file.as_ref().map_or(0, |f| f.0.len()) as u64, "grains.file.path".to_string(), format!("{path} ({} grains)", file.as_ref().map_or(0, |f| f.0.len()))),
+        Grains::Pack(spec) => (spec.count as u64, "grains.pack.count".to_string(), spec.count.to_string()),
+    };
+    match (&scene.grains, &file) {
+        (Grains::List(list), _) => consistency::given_coordinates(list.iter().map(|g| (Vec2::from(g.x), g.r)), |k| format!("grains.list[{k}]"))?,
+        (Grains::File { path, .. }, Some((grains, lines))) => consistency::given_coordinates(grains.iter().cloned(), |k| format!("the grain on line {} of {path}", lines[k]))?,
+        _ => {}
+    }
+    // The x length the rough walls span: the periodic cell, the packing's region, or the
+    // listed grains' extent.
+    let mut length = boundary.period;
+    if length == 0.0 {
+        length = match (&scene.grains, &file) {
+            (Grains::Pack(spec), _) => spec.x[1] - spec.x[0],
+            (Grains::List(list), _) => extent(list.iter().map(|g| (g.x[0], g.r))),
+            (_, Some((grains, _))) => extent(grains.iter().map(|(x, r)| (x.x, *r))),
+            _ => 0.0,
+        };
+    }
+    // Named by the wall with the most.
+    let mut wall_grains = (0u64, String::new(), String::new());
+    let mut most = 0.0;
+    if let Some(ws) = &scene.walls {
+        for (name, spec) in [("bottom", &ws.bottom), ("top", &ws.top)] {
+            if let SurfaceSpec::Rough { radius } = spec.surface {
+                let n = glued_count(length, radius);
+                wall_grains.0 = wall_grains.0.saturating_add(if n < 1e18 { n as u64 } else { u64::MAX });
+                if n > most {
+                    most = n;
+                    wall_grains.1 = format!("walls.{name}.surface.rough.radius");
+                    wall_grains.2 = format!("{} m ({n:.0} grains over {} m)", radius.shown(), length.shown());
+                }
+            }
+        }
+    }
+    let mut estimate = MemoryEstimate { grains: (count, count_field, count_value), wall_grains, materials: mats.len() as u64, ..Default::default() };
+    limits.check(&estimate)?;
+
+    let mut p = Particles::default();
+    let push = |p: &mut Particles, x: Vec2, v: Vec2, w: f64, r: f64, mat: usize| {
+        let m = shape.mass(r, mats[mat].density);
+        p.push(x, v, w, r, m, shape.inertia(r, m), mat as u16);
+    };
+    let mut names = GrainNames::of(scene);
+    let mut packed = false;
+    match &scene.grains {
+        Grains::List(list) => {
+            for g in list {
+                push(&mut p, Vec2::from(g.x), Vec2::from(g.v), g.omega, g.r, g.material);
+            }
+        }
+        Grains::File { material, .. } => {
+            let (grains, lines) = file.expect("read above");
+            for (x, r) in grains {
+                push(&mut p, x, Vec2::zeros(), 0.0, r, *material);
+            }
+            if let GrainNames::File(_, l) = &mut names {
+                *l = lines;
+            }
+        }
+        Grains::Pack(spec) => {
+            let (lo, hi) = spec.radius.bounds();
+            let bound = crate::scene::limits::MAX_COORDINATE_RADII * hi;
+            let coordinate_ok = |v: f64| v.abs() <= bound;
+            let y0 = scene.grains_floor().expect("validated: y_min or walls");
+            for (field, v) in [("x", spec.x[0]), ("x", spec.x[1]), ("y_min", y0)] {
+                crate::error::check(coordinate_ok(v), "grains.pack", field, v, &format!("within {bound:e} m of the origin ({:e} largest radii)", crate::scene::limits::MAX_COORDINATE_RADII))?;
+            }
+            let mass_ok = |r: f64| {
+                let m = shape.mass(r, mats[spec.material].density);
+                m.is_finite() && m > 0.0
+            };
+            crate::error::check(mass_ok(lo) && mass_ok(hi), "grains.pack", "radius", format!("[{lo}, {hi}] m"), "radii whose masses are finite and > 0 at this density")?;
+            let radii = spec.radius.sample(spec.count, spec.seed);
+            let area: f64 = radii.iter().map(|r| std::f64::consts::PI * r * r).sum();
+            let lx = spec.x[1] - spec.x[0];
+            let h = area / (spec.packing_fraction * lx);
+            let r_max = radii.iter().cloned().fold(0.0, f64::max);
+            // Too few grains to fill the x range one grain high at this packing fraction.
+            if !(h >= 2.0 * r_max) {
+                let need = (2.0 * r_max * spec.packing_fraction * lx / (area / spec.count as f64)).ceil();
+                let allowed = format!(">= about {} (to fill x = [{}, {}] m at packing_fraction {} at least one grain diameter high)", need.shown(), spec.x[0].shown(), spec.x[1].shown(), spec.packing_fraction);
+                return Err(Error::Invalid { field: "grains.pack.count".into(), value: spec.count.to_string(), allowed });
+            }
+            // Periodic over the cell when the region is the cell (the packing then wraps);
+            // a narrower region is packed between its ends. The region at least a grain
+            // wide (two, over a periodic cell: a grain must not meet its own image), and its
+            // top within the coordinates' bound.
+            let periodic = boundary.is_periodic() && spec.x[0] == boundary.x_min && spec.x[1] == boundary.x_min + boundary.period;
+            let widest = if periodic { 4.0 * r_max } else { 2.0 * r_max };
+            crate::error::check(lx >= widest, "grains.pack", "x", format!("[{}, {}]", spec.x[0].shown(), spec.x[1].shown()), &format!("a region at least {} m wide ({} the largest radius drawn, {} m)", widest.shown(), if periodic { "four times" } else { "twice" }, r_max.shown()))?;
+            crate::error::check(coordinate_ok(y0 + h), "grains.pack", "count", spec.count, &format!("a packing whose top (y = {} m, from the count, radii and packing_fraction) lies within {bound:e} m of the origin", (y0 + h).shown()))?;
+            // The region must fit under a top wall placed by the scene.
+            if let Some(ws) = &scene.walls
+                && let Some(t) = ws.top.y
+            {
+                let top_surface = t - ws.top.surface.radius();
+                crate::error::check(
+                    y0 + h <= top_surface,
+                    "walls.top",
+                    "y",
+                    t,
+                    &format!(">= {} m: the packing fills y = [{y0}, {}] m (its count at its packing_fraction), below the top wall's surface", y0 + h + ws.top.surface.radius(), y0 + h),
+                )?;
+            }
+            let centres = relaxed_packing(&radii, spec.x[0], spec.x[1], y0, y0 + h, periodic, spec.seed);
+            // A packing's order is arbitrary: store it along a space-filling curve.
+            for k in crate::scene::pack::morton_order(&centres, spec.x[0], y0, 2.0 * r_max) {
+                push(&mut p, centres[k], Vec2::zeros(), 0.0, radii[k], spec.material);
+            }
+            packed = true;
+        }
+    }
+    p.n_free = p.len();
+    if length == 0.0 {
+        length = 2.0 * p.r[0];
+    }
+    let n_free = p.n_free;
+    let mean_r = p.r.iter().sum::<f64>() / n_free as f64;
+    let depth = match &scene.walls {
+        Some(w) => w.thickness.unwrap_or(shape.depth(2.0 * mean_r)),
+        None => shape.depth(2.0 * mean_r),
+    };
+
+    // Walls.
+    let mut walls = Vec::new();
+    if let Some(ws) = &scene.walls {
+        let top_of_grains = (0..n_free).map(|i| p.x[i].y + p.r[i]).fold(f64::NEG_INFINITY, f64::max);
+        let x0 = if boundary.is_periodic() { boundary.x_min } else { p.x.iter().map(|x| x.x).fold(f64::INFINITY, f64::min) };
+        for (name, spec, side) in [("bottom", &ws.bottom, 1.0), ("top", &ws.top, -1.0)] {
+            let rough_r = spec.surface.radius();
+            let y = spec.y.unwrap_or(top_of_grains + rough_r);
+            let surface = match spec.surface {
+                SurfaceSpec::Flat => Surface::Flat,
+                SurfaceSpec::Rough { radius } => {
+                    let count = glued_count(length, radius) as usize;
+                    let start = p.len();
+                    for k in 0..count {
+                        let x = x0 + (k as f64 + 0.5) * length / count as f64;
+                        push(&mut p, Vec2::new(x, y), Vec2::new(spec.velocity_x, 0.0), 0.0, radius, spec.material);
+                    }
+                    Surface::Rough { grains: start..p.len() }
+                }
+            };
+            let mass = spec.mass.unwrap_or_else(|| match &surface {
+                Surface::Rough { grains } => grains.clone().map(|k| p.m[k]).sum(),
+                Surface::Flat => (length / (2.0 * mean_r)) * shape.mass(mean_r, mats[spec.material].density),
+            });
+            let control = match spec.control {
+                ControlSpec::Fixed => Control::Fixed,
+                ControlSpec::Pressure(pa) => Control::Load { force: pa * length * depth },
+            };
+            walls.push(Wall {
+                name,
+                surface,
+                control,
+                side,
+                y,
+                x_shift: 0.0,
+                v: Vec2::new(spec.velocity_x, 0.0),
+                mass,
+                glued_radius: rough_r,
+                material: spec.material,
+                force: Vec2::zeros(),
+                force_prev: Vec2::zeros(),
+            });
+        }
+    }
+
+    // Where the grains sit: coordinates, masses, the periodic cell, the walls, overlaps.
+    consistency::coordinates(scene, &p, &names, &walls)?;
+    consistency::masses(&p, &names, &walls, mats)?;
+    consistency::periodic_cell(&boundary, &p)?;
+    let worst = consistency::start_overlaps(&p, &walls, &boundary, &names, if packed { MAX_PACKING_OVERLAP } else { MAX_START_OVERLAP }, scene)?;
+    // The largest overlap at the start, and the speed its stored energy would throw two
+    // grains apart at: sqrt(E*/rho) (dn/r)^(5/4) (Hertz: the speed of an impact that
+    // presses a contact in that far).
+    let start_overlap = worst.map(|(i, j, ratio)| {
+        let (a, b) = (&mats[p.material[i] as usize], &mats[p.material[j] as usize]);
+        let release = (PairMaterial::mix(a, b).e_star / a.density.min(b.density)).sqrt() * ratio.powf(1.25);
+        (ratio, format!("{} and {}", names.name(i, &p, &walls), names.name(j, &p, &walls)), release)
+    });
+
+    // Time step from the smallest grain.
+    let friction = scene.model.tangential != TangentialSpec::Frictionless;
+    let imin = (0..n_free).min_by(|&a, &b| p.r[a].total_cmp(&p.r[b])).expect("at least one grain");
+    let (r, m, i) = (p.r[imin], p.m[imin], p.inertia[imin]);
+    let mat = &mats[p.material[imin] as usize];
+    let mut refs = vec![RefContact::twin(r, m, i, PairMaterial::mix(mat, mat))];
+    // Against each flat wall, with the wall's own material.
+    for w in walls.iter().filter(|w: &&Wall| w.is_flat()) {
+        refs.push(RefContact::wall(r, m, i, PairMaterial::mix(mat, &mats[w.material])));
+    }
+    let ts = &scene.time_step;
+    // An accuracy rule is resolved into steps per contact before the engine is built
+    // (`crate::study::build`: the calibration runs engines of its own).
+    if let TimeStepRule::Accuracy { .. } = ts.rule {
+        return Err(Error::Scene("an accuracy time step rule must be resolved first: build the scene with grainlab::build (the study's build), which calibrates it".into()));
+    }
+    let time_step = choose(&ts.rule, ts.characteristic_speed, ts.allow_unstable, &refs, (r, m, mat), friction)?;
+    let dt = time_step.dt_s;
+    let steps = crate::engine::timestep::step_count(scene.duration, dt, "duration")?;
+    // The rows the summary keeps: a wall row per sample, an impact curve point per step
+    // in contact (at most every step, and at most MAX_CURVE_POINTS).
+    let samples = (scene.output.samples as f64).min(steps as f64);
+    let (rows, field, value) = if scene.analysis == Analysis::Impact {
+        let curve = (steps as f64).min(crate::scene::limits::MAX_CURVE_POINTS as f64);
+        (curve + samples, "duration".to_string(), format!("{} s ({steps} steps of {dt:.3e} s)", scene.duration))
+    } else {
+        (samples, "output.samples".to_string(), scene.output.samples.to_string())
+    };
+    estimate.rows = (rows as u64, field, value);
+    limits.check(&estimate)?;
+    consistency::motion(&p, &walls, Vec2::from(scene.gravity), &names, dt)?;
+    consistency::load(scene, &p, &walls, length, depth, dt)?;
+    consistency::stable_for_every_pair(scene, &p, &walls, &time_step)?;
+    consistency::drag(scene, dt)?;
+    consistency::impact(scene, &p, &walls, &boundary, scene.duration)?;
+
+    let r_min = p.r[..n_free].iter().cloned().fold(f64::INFINITY, f64::min);
+    let skin = scene.neighbor.skin * 2.0 * r_min;
+    let domain = Domain::new(&p, &walls, &boundary, travel(scene, &p, &walls), MAX_STEP_MOVE * r_min);
+    let start_speed = (0..n_free).map(|k| p.v[k].norm()).chain(walls.iter().map(|w| w.v.norm())).fold(0.0, f64::max);
+    let context = Context {
+        start_overlap,
+        characteristic_speed: time_step.characteristic_speed_m_s,
+        contact_time: time_step.contact_time_s,
+        stability_limit: time_step.stability_limit_s,
+        allow_unstable: ts.allow_unstable,
+        pressure: scene.walls.as_ref().and_then(|w| if let ControlSpec::Pressure(pa) = w.top.control { Some(pa) } else { None }),
+        start_speed,
+    };
+    let options = ModelOptions { limit_force: scene.model.limit_force, lever_arm: scene.model.lever_arm };
+    let all_elastic = mats.iter().all(|m| m.restitution == 1.0);
+    let threads = crate::kernels::threads::Threads::new(threads)?;
+    let parts = Parts { p, boundary, walls, dt, skin, scene, threads, domain, context };
+    let engine: Box<dyn Engine> = match (scene.model.tangential, all_elastic) {
+        (TangentialSpec::Frictionless, false) => parts.assemble(HertzFrictionless::new(options))?,
+        (TangentialSpec::Frictionless, true) => parts.assemble(HertzFrictionlessElastic::new(options))?,
+        (TangentialSpec::TotalDisplacement, false) => parts.assemble(LiggghtsHertzHistory::new(options))?,
+        (TangentialSpec::TotalDisplacement, true) => parts.assemble(LiggghtsHertzHistoryElastic::new(options))?,
+        (TangentialSpec::IncrementalForce, false) => parts.assemble(YadeMindlin::new(options))?,
+        (TangentialSpec::IncrementalForce, true) => parts.assemble(YadeMindlinElastic::new(options))?,
+    };
+    Ok(Built { engine, time_step, depth, length })
+}
+
+/// The x extent of grains given as (x, r), m.
+fn extent(grains: impl Iterator<Item = (f64, f64)>) -> f64 {
+    let (lo, hi, r0) = grains.fold((f64::INFINITY, f64::NEG_INFINITY, 0.0f64), |(a, b, r0), (x, r)| (a.min(x), b.max(x), if r0 == 0.0 { r } else { r0 }));
+    (hi - lo).max(2.0 * r0)
+}
+
+/// How far a grain may travel from its first place over the run where no wall or
+/// periodic cell bounds it, m: four times what the fastest it could go carries it. The
+/// fastest: the whole kinetic energy the scene starts with in its lightest grain, plus
+/// twice the fastest wall's speed (a grain dragged along and flung), plus gravity's
+/// pull over the run.
+fn travel(scene: &Scene, p: &Particles, walls: &[Wall]) -> f64 {
+    let n = p.n_free;
+    let energy: f64 = (0..n).map(|i| 0.5 * p.m[i] * p.v[i].norm_squared() + 0.5 * p.inertia[i] * p.omega[i] * p.omega[i]).sum();
+    let m_min = p.m[..n].iter().cloned().fold(f64::INFINITY, f64::min);
+    let v_walls = walls.iter().map(|w| w.v.norm()).fold(0.0, f64::max);
+    let t = scene.duration;
+    let g = Vec2::from(scene.gravity).norm();
+    let speed = (2.0 * energy / m_min).sqrt() + 2.0 * v_walls + g * t;
+    4.0 * speed * t
+}
+
+struct Parts<'a> {
+    p: Particles,
+    domain: Domain,
+    context: Context,
+    boundary: Boundary,
+    walls: Vec<Wall>,
+    dt: f64,
+    skin: f64,
+    scene: &'a Scene,
+    threads: crate::kernels::threads::Threads,
+}
+
+impl Parts<'_> {
+    fn assemble<Dm: Damping, T: Tangential>(self, law: ContactModel<Dm, T>) -> Result<Box<dyn Engine>, Error> {
+        if self.scene.output.energy { self.assemble_with::<Dm, T, true>(law) } else { self.assemble_with::<Dm, T, false>(law) }
+    }
+
+    fn assemble_with<Dm: Damping, T: Tangential, const E: bool>(self, law: ContactModel<Dm, T>) -> Result<Box<dyn Engine>, Error> {
+        type L<Dm, T> = ContactModel<Dm, T>;
+        let scene = self.scene;
+        let rotation = T::FRICTION && scene.model.rotation;
+        let has_walls = !self.walls.is_empty();
+        let has_flat = self.walls.iter().any(Wall::is_flat);
+        let gravity = Vec2::from(scene.gravity);
+        let n_free = self.p.n_free;
+        let wall_hist = self.walls.iter().map(|w| if w.is_flat() { vec![ContactHistory::default(); n_free] } else { Vec::new() }).collect();
+        let wall_active = self.walls.iter().map(|w| vec![false; if w.is_flat() { n_free } else { 0 }]).collect();
+        let world = World {
+            p: self.p,
+            boundary: self.boundary,
+            law,
+            pair_table: PairTable::new(&scene.materials),
+            pairs: PairList { keep_energy: E, ..Default::default() },
+            walls: self.walls,
+            wall_hist,
+            wall_active,
+            neighbours: Neighbours::new(self.skin),
+            ledger: EnergyLedger::default(),
+            gravity,
+            dt: self.dt,
+            step: 0,
+            max_overlap: (0.0, 0, 0),
+            initial_energy: 0.0,
+            energy: E,
+            threads: self.threads.clone(),
+            kick: Default::default(),
+            zeroed: Default::default(),
+            domain: self.domain,
+            context: self.context,
+        };
+        // The force stages, shared by the step and by the set-up at t = 0.
+        let threads = self.threads.clone();
+        let forces = || -> Result<Vec<Box<dyn Stage<L<Dm, T>>>>, Error> {
+            let mut s: Vec<Box<dyn Stage<L<Dm, T>>>> = vec![Box::new(UpdateNeighbours), Box::new(ClearForces)];
+            if gravity != Vec2::zeros() {
+                s.push(Box::new(Gravity::<E>));
+            }
+            if let Some(c) = scene.model.general_damping {
+                s.push(Box::new(GeneralDamping::<E>::new(c)));
+            }
+            s.push(if rotation { pair_stage::<Dm, T, E, true>(&threads) } else { pair_stage::<Dm, T, E, false>(&threads) });
+            if has_flat {
+                s.push(Box::new(FlatWallForces::<E>));
+            }
+            Ok(s)
+        };
+        let mut stages: Vec<Box<dyn Stage<L<Dm, T>>>> = Vec::new();
+        // The walls first: their grains follow them in the drift.
+        if has_walls {
+            stages.push(Box::new(MoveWalls));
+        }
+        if rotation {
+            stages.push(Box::new(InitialIntegrate::<true>::default()));
+        } else {
+            stages.push(Box::new(InitialIntegrate::<false>::default()));
+        }
+        stages.extend(forces()?);
+        if has_walls {
+            stages.push(Box::new(FinishWalls::<E>));
+        }
+        if rotation {
+            stages.push(Box::new(FinalIntegrate::<true>));
+        } else {
+            stages.push(Box::new(FinalIntegrate::<false>));
+        }
+        stages.push(Box::new(Watchdog { max_overlap: MAX_START_OVERLAP, every: 100 }));
+        let mut setup = forces()?;
+        if has_walls {
+            setup.push(Box::new(FinishWalls::<E>));
+        }
+        Ok(Box::new(Simulation::new(world, stages, setup)?))
+    }
+}
+
+/// The grain-grain contact stage: serial, or on the run's pool of threads; with `SPIN` when
+/// the grains rotate (without, the kernel neither reads spins nor computes torques).
+fn pair_stage<Dm: Damping, T: Tangential, const E: bool, const SPIN: bool>(threads: &crate::kernels::threads::Threads) -> Box<dyn Stage<ContactModel<Dm, T>>> {
+    #[cfg(feature = "parallel")]
+    if threads.count() > 1 {
+        return Box::new(crate::engine::parallel::ParallelPairForces::<E, SPIN>::new(threads.clone()));
+    }
+    let _ = threads;
+    Box::new(PairForces::<E, SPIN>::default())
+}

@@ -1,0 +1,57 @@
+//! Neighbours: when to rebuild the Verlet list (a grain moved more than half the skin
+//! since the last build) and the rebuild itself, from the cell list
+//! ([`crate::kernels::cells`]) into the list ([`crate::kernels::pairs`]).
+
+use crate::kernels::cells::cell_pairs;
+use crate::kernels::threads::Threads;
+use crate::physics::boundary::Boundary;
+use crate::physics::dim::Vec2;
+
+/// Cell-list builder and the skin bookkeeping.
+#[derive(Clone, Debug)]
+pub struct Neighbours {
+    /// Skin, m.
+    pub skin: f64,
+    /// Positions at the last build.
+    x_at_build: Vec<Vec2>,
+    /// Number of builds so far.
+    pub builds: u64,
+    cell_start: Vec<u32>,
+    cell_items: Vec<u32>,
+    /// Set by the stages that move grains (the drift, the walls) when one of them has
+    /// moved more than half the skin since the last build; cleared by the build.
+    pub moved_far: bool,
+}
+
+impl Neighbours {
+    pub fn new(skin: f64) -> Self {
+        Neighbours { skin, x_at_build: Vec::new(), builds: 0, cell_start: Vec::new(), cell_items: Vec::new(), moved_far: false }
+    }
+
+    /// Half the skin, squared: a grain that has moved this far (squared) since the last
+    /// build may have a new neighbour, m^2.
+    pub fn limit(&self) -> f64 {
+        0.25 * self.skin * self.skin
+    }
+
+    /// Positions at the last build (empty before the first).
+    pub fn at_build(&self) -> &[Vec2] {
+        &self.x_at_build
+    }
+
+    /// True when the list must be rebuilt: there is none for these `n` grains yet, or a
+    /// grain has moved more than half the skin ([`Neighbours::moved_far`], set with
+    /// [`Boundary::any_moved_beyond`]).
+    pub fn needs_rebuild(&self, n: usize) -> bool {
+        self.x_at_build.len() != n || self.moved_far
+    }
+
+    /// Build the pair list with the cell list.
+    pub fn build(&mut self, x: &[Vec2], r: &[f64], n_free: usize, boundary: &Boundary, threads: &Threads) -> Vec<[u32; 2]> {
+        self.builds += 1;
+        self.moved_far = false;
+        self.x_at_build.clear();
+        self.x_at_build.extend_from_slice(x);
+        cell_pairs(x, r, n_free, boundary, self.skin, &mut self.cell_start, &mut self.cell_items, threads)
+    }
+}

@@ -1,0 +1,150 @@
+//! The simulation: a world and the pipeline of stages that advances it, with a timer per
+//! stage, behind the [`Engine`] trait (one dynamic call per step, whatever the contact
+//! model), which hands observers a read-only [`View`].
+
+use std::time::{Duration, Instant};
+
+use crate::engine::world::{Stage, View, World};
+use crate::error::Error;
+use crate::physics::boundary::Boundary;
+use crate::physics::contact::ContactLaw;
+use crate::physics::energy::EnergyRow;
+use crate::physics::particles::Particles;
+use crate::physics::walls::Wall;
+
+/// A world and its pipeline, with a timer per stage.
+pub struct Simulation<L: ContactLaw> {
+    pub world: World<L>,
+    stages: Vec<Box<dyn Stage<L>>>,
+    timers: Vec<Duration>,
+}
+
+impl<L: ContactLaw> Simulation<L> {
+    pub fn new(mut world: World<L>, stages: Vec<Box<dyn Stage<L>>>, setup: Vec<Box<dyn Stage<L>>>) -> Result<Self, Error> {
+        // Forces at the initial positions, so that the first half kick has them. With
+        // dt = 0 the stages move nothing and integrate no work: they only prime the
+        // forces and the contacts' previous-step values of the energy integrals.
+        let dt = world.dt;
+        world.dt = 0.0;
+        for mut s in setup {
+            s.run(&mut world)?;
+        }
+        world.dt = dt;
+        let (a, b, c) = world.kinetic();
+        world.initial_energy = a + b + c + world.ledger.elastic_normal + world.ledger.elastic_tangential;
+        let timers = vec![Duration::ZERO; stages.len()];
+        Ok(Simulation { world, stages, timers })
+    }
+
+    /// Advance one step.
+    #[inline]
+    pub fn step(&mut self) -> Result<(), Error> {
+        self.advance(true)
+    }
+
+    /// Advance one step; with `look` false nothing will look at the grains' velocities
+    /// (or spins) before the next step, so the final half kick may be left to the next
+    /// drift (the same bits: [`crate::engine::integrate`]). After an error the state is whole.
+    #[inline]
+    pub fn advance(&mut self, look: bool) -> Result<(), Error> {
+        self.world.step += 1;
+        self.world.kick.defer = !look;
+        for (s, t) in self.stages.iter_mut().zip(self.timers.iter_mut()) {
+            let t0 = Instant::now();
+            let done = s.run(&mut self.world);
+            *t += t0.elapsed();
+            if done.is_err() {
+                crate::engine::integrate::settle(&mut self.world);
+            }
+            done?;
+        }
+        Ok(())
+    }
+
+    /// The stage names in order.
+    pub fn stage_names(&self) -> Vec<String> {
+        self.stages.iter().map(|s| s.name()).collect()
+    }
+    /// Time spent in each stage so far.
+    pub fn timings(&self) -> Vec<(String, Duration)> {
+        self.stage_names().into_iter().zip(self.timers.iter().cloned()).collect()
+    }
+}
+
+/// A running simulation behind one dynamic call per step, whatever its contact model.
+pub trait Engine: Send {
+    fn step(&mut self) -> Result<(), Error>;
+    /// One step, after which nothing looks at the grains' velocities or spins (`look`
+    /// false) before the next: see [`Simulation::advance`].
+    fn advance(&mut self, look: bool) -> Result<(), Error>;
+    fn particles(&self) -> &Particles;
+    fn walls(&self) -> &[Wall];
+    fn boundary(&self) -> Boundary;
+    fn energy_row(&self) -> EnergyRow;
+    fn steps(&self) -> u64;
+    fn time(&self) -> f64;
+    fn dt(&self) -> f64;
+    /// Number of pairs touching now.
+    fn touching(&self) -> usize;
+    /// Number of neighbour-list builds so far.
+    fn neighbour_builds(&self) -> u64;
+    /// The stages in order.
+    fn stage_names(&self) -> Vec<String>;
+    fn timings(&self) -> Vec<(String, Duration)>;
+    /// The contact model in one line.
+    fn model(&self) -> String;
+    /// The full state check ([`World::health`]).
+    fn health(&self) -> Result<(), Error>;
+    /// A read-only view of the state, what observers and outputs read.
+    fn view(&self) -> View<'_> {
+        View { particles: self.particles(), walls: self.walls(), boundary: self.boundary(), time: self.time() }
+    }
+}
+
+impl<L: ContactLaw> Engine for Simulation<L> {
+    fn step(&mut self) -> Result<(), Error> {
+        Simulation::step(self)
+    }
+    fn advance(&mut self, look: bool) -> Result<(), Error> {
+        Simulation::advance(self, look)
+    }
+    fn particles(&self) -> &Particles {
+        &self.world.p
+    }
+    fn walls(&self) -> &[Wall] {
+        &self.world.walls
+    }
+    fn boundary(&self) -> Boundary {
+        self.world.boundary
+    }
+    fn energy_row(&self) -> EnergyRow {
+        self.world.energy_row()
+    }
+    fn steps(&self) -> u64 {
+        self.world.step
+    }
+    fn time(&self) -> f64 {
+        self.world.time()
+    }
+    fn dt(&self) -> f64 {
+        self.world.dt
+    }
+    fn touching(&self) -> usize {
+        self.world.pairs.touching() + self.world.wall_active.iter().flatten().filter(|&&a| a).count()
+    }
+    fn neighbour_builds(&self) -> u64 {
+        self.world.neighbours.builds
+    }
+    fn stage_names(&self) -> Vec<String> {
+        Simulation::stage_names(self)
+    }
+    fn timings(&self) -> Vec<(String, Duration)> {
+        Simulation::timings(self)
+    }
+    fn model(&self) -> String {
+        self.world.law.describe()
+    }
+    fn health(&self) -> Result<(), Error> {
+        self.world.health()
+    }
+}

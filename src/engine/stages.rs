@@ -1,0 +1,323 @@
+//! The step's stages: the [`Stage`] trait and every stage a scene may ask for, in the
+//! order a step runs them (walls, neighbours, forces, the contact stages, walls'
+//! forces, the watchdog); the drift and the kicks are [`crate::engine::integrate`]. A
+//! scene without walls has no wall stages, without gravity no gravity stage, without
+//! friction no spin update; `explain` prints the list. The contact stages hand the
+//! World's slices to the kernels ([`crate::kernels::driver`]).
+
+use crate::engine::world::World;
+use crate::error::Error;
+use crate::kernels::driver::{Ledgers, PairOut, PairSlices, PairView, compute_pairs};
+use crate::kernels::sweep::sort_pairs;
+use crate::physics::contact::damping::Damping;
+use crate::physics::contact::tangential::Tangential;
+use crate::physics::contact::{ContactInput, ContactLaw, ContactModel, EnergyTerms};
+use crate::physics::dim::{Vec2, cross};
+use crate::physics::walls::{Control, Surface};
+
+pub use crate::engine::world::Stage;
+
+/// Move the walls: prescribed x velocity, and for a loaded wall the first half kick and
+/// drift in y. Their glued grains follow in the drift that comes next
+/// ([`crate::physics::walls::Glued`], in [`crate::engine::integrate::InitialIntegrate`]), on the thread that owns them.
+pub struct MoveWalls;
+
+impl<L: ContactLaw> Stage<L> for MoveWalls {
+    fn name(&self) -> String {
+        "MoveWalls".into()
+    }
+    fn run(&mut self, w: &mut World<L>) -> Result<(), Error> {
+        let dt = w.dt;
+        for wall in &mut w.walls {
+            if let Control::Load { .. } = wall.control {
+                wall.v.y += 0.5 * dt * (wall.force.y + wall.load_y()) / wall.mass;
+            }
+            let d = wall.v * dt;
+            wall.y += d.y;
+            wall.x_shift += d.x;
+        }
+        Ok(())
+    }
+}
+
+/// Rebuild the Verlet list when a grain has moved more than half the skin.
+pub struct UpdateNeighbours;
+
+impl<L: ContactLaw> Stage<L> for UpdateNeighbours {
+    fn name(&self) -> String {
+        "Neighbours".into()
+    }
+    fn run(&mut self, w: &mut World<L>) -> Result<(), Error> {
+        if w.neighbours.needs_rebuild(w.p.len()) {
+            // Every grain inside the domain, none that jumped: checked here, where the
+            // rebuild passes over all grains anyway.
+            w.check_domain()?;
+            let pairs = w.neighbours.build(&w.p.x, &w.p.r, w.p.n_free, &w.boundary, &w.threads);
+            w.pairs.replace(pairs, &w.p.r, &w.p.m, &w.threads);
+        }
+        Ok(())
+    }
+}
+
+/// Zero forces and torques (and start the step's stored-energy sums): those the drift
+/// has not set to zero already ([`World::zeroed`]; in a step, the rough walls' grains).
+pub struct ClearForces;
+
+impl<L: ContactLaw> Stage<L> for ClearForces {
+    fn name(&self) -> String {
+        "ClearForces".into()
+    }
+    fn run(&mut self, w: &mut World<L>) -> Result<(), Error> {
+        let n = w.p.len();
+        let z = std::mem::take(&mut w.zeroed);
+        w.threads.split(n - z.forces, &mut w.p.f[z.forces..], |f| f.fill(Vec2::zeros()));
+        if L::Tang::FRICTION {
+            w.threads.split(n - z.torques, &mut w.p.torque[z.torques..], |t| t.fill(0.0));
+        }
+        w.ledger.begin_step();
+        w.max_overlap = (0.0, 0, 0);
+        Ok(())
+    }
+}
+
+/// Gravity on the free grains.
+pub struct Gravity<const ENERGY: bool>;
+
+impl<L: ContactLaw, const ENERGY: bool> Stage<L> for Gravity<ENERGY> {
+    fn name(&self) -> String {
+        "Gravity".into()
+    }
+    fn run(&mut self, w: &mut World<L>) -> Result<(), Error> {
+        let g = w.gravity;
+        for i in 0..w.p.n_free {
+            w.p.f[i] += w.p.m[i] * g;
+            if ENERGY {
+                // Constant force: the work over the step is exact with the step's displacement.
+                w.ledger.gravity += w.p.m[i] * g.dot(&w.p.v[i]) * w.dt;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The seed's general damping: `F = -c m v`, `M = -c I w` on every free grain, with the
+/// half-step velocities the contact forces see. Its work is integrated by the trapezoid
+/// rule like every other term of the balance.
+pub struct GeneralDamping<const ENERGY: bool> {
+    /// Rate c, 1/s.
+    pub rate: f64,
+    prev_f: Vec<Vec2>,
+    prev_m: Vec<f64>,
+}
+
+impl<const ENERGY: bool> GeneralDamping<ENERGY> {
+    pub fn new(rate: f64) -> Self {
+        GeneralDamping { rate, prev_f: Vec::new(), prev_m: Vec::new() }
+    }
+}
+
+impl<L: ContactLaw, const ENERGY: bool> Stage<L> for GeneralDamping<ENERGY> {
+    fn name(&self) -> String {
+        format!("GeneralDamping(c = {} 1/s)", self.rate)
+    }
+    fn run(&mut self, w: &mut World<L>) -> Result<(), Error> {
+        let c = self.rate;
+        let n = w.p.n_free;
+        // The first call has no previous force: take this one (the set-up stages, run
+        // with dt = 0 before the first step, are a separate instance).
+        let first = ENERGY && self.prev_f.len() != n;
+        if first {
+            self.prev_f = vec![Vec2::zeros(); n];
+            self.prev_m = vec![0.0; n];
+        }
+        for i in 0..n {
+            let f = -c * w.p.m[i] * w.p.v[i];
+            let m = -c * w.p.inertia[i] * w.p.omega[i];
+            if first {
+                self.prev_f[i] = f;
+                self.prev_m[i] = m;
+            }
+            w.p.f[i] += f;
+            w.p.torque[i] += m;
+            if ENERGY {
+                w.ledger.general_damping -= 0.5 * ((self.prev_f[i] + f).dot(&w.p.v[i]) + (self.prev_m[i] + m) * w.p.omega[i]) * w.dt;
+                self.prev_f[i] = f;
+                self.prev_m[i] = m;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Grain-grain contacts over the Verlet list, in two passes: a branch-free sweep sorts
+/// out the pairs that are touching (and those just released), then the kernel runs on
+/// those only, four at a time in SIMD lanes. Most listed pairs are not touching (the
+/// skin): the sweep spares them the kernel. `SPIN`: the grains rotate (the pairs' torques
+/// are computed and collected).
+#[derive(Default)]
+pub struct PairForces<const ENERGY: bool, const SPIN: bool> {
+    touching: Vec<u32>,
+    sep: Vec<Vec2>,
+    released: Vec<u32>,
+    pending: Vec<EnergyTerms>,
+}
+
+impl<Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN: bool> Stage<ContactModel<Dm, T>> for PairForces<ENERGY, SPIN> {
+    fn name(&self) -> String {
+        "PairContacts".into()
+    }
+    fn run(&mut self, w: &mut World<ContactModel<Dm, T>>) -> Result<(), Error> {
+        let mut worst = w.max_overlap;
+        let mut f = std::mem::take(&mut w.p.f);
+        let mut torque = std::mem::take(&mut w.p.torque);
+        let (pairs, consts) = (w.pairs.pairs.checked(), &w.pairs.consts);
+        let (nt, nr) = sort_pairs(&w.p.x, &w.boundary, pairs, &w.pairs.reach, &w.pairs.active, &[], &mut self.touching, &mut self.sep, &mut self.released);
+        let (touching, sep, released) = (&self.touching[..nt], &self.sep[..nt], &self.released[..nr]);
+        let view = PairView { p: &w.p, boundary: w.boundary, law: w.law, pair_table: &w.pair_table, dt: w.dt };
+        let list = PairSlices::<T> { pairs, consts, hist: &mut w.pairs.hist, energy: &mut w.pairs.energy, active: &mut w.pairs.active };
+        // Each pair's force goes to its grains as it comes, in list order.
+        let n = f.len();
+        let (fs, ts) = (&mut f[..n], &mut torque[..n]);
+        let sink = |_, (i, j): (usize, usize), o: PairOut| {
+            fs[i] += o.force;
+            fs[j] -= o.force;
+            if T::FRICTION && SPIN {
+                ts[i] -= o.torque[0];
+                ts[j] -= o.torque[1];
+            }
+        };
+        let (ratio, k) = compute_pairs::<Dm, T, ENERGY, SPIN>(&view, list, touching, sep, released, Ledgers::One(&mut w.ledger), sink, &mut self.pending);
+        if ratio > worst.0 {
+            let [i, j] = pairs.pairs()[k];
+            worst = (ratio, i as usize, j as usize);
+        }
+        w.p.f = f;
+        w.p.torque = torque;
+        w.max_overlap = worst;
+        Ok(())
+    }
+}
+
+/// Contacts of free grains with flat walls (R* = r, m* = m).
+pub struct FlatWallForces<const ENERGY: bool>;
+
+impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> for FlatWallForces<ENERGY> {
+    fn name(&self) -> String {
+        "FlatWallContacts".into()
+    }
+    fn run(&mut self, w: &mut World<ContactModel<Dm, T>>) -> Result<(), Error> {
+        let model = w.law;
+        let lever = model.options.lever_arm;
+        let dt = w.dt;
+        let p = &mut w.p;
+        let mut worst = w.max_overlap;
+        for (k, wall) in w.walls.iter_mut().enumerate() {
+            if !wall.is_flat() {
+                continue;
+            }
+            let (hist, active) = (&mut w.wall_hist[k], &mut w.wall_active[k]);
+            let n = Vec2::new(0.0, wall.side);
+            let mut on_wall = Vec2::zeros();
+            for i in 0..p.n_free {
+                let h = &mut hist[i];
+                let gap = wall.side * (p.x[i].y - wall.y);
+                let ri = p.r[i];
+                if gap >= ri {
+                    if active[i] {
+                        let spin = if T::FRICTION { ri * p.omega[i] } else { 0.0 };
+                        let vc = p.v[i] - wall.v + spin * Vec2::new(n.y, -n.x);
+                        model.release::<ENERGY>(vc, n, dt, &mut h.tangential, &mut h.energy, &mut w.ledger);
+                        active[i] = false;
+                    }
+                    continue;
+                }
+                let dn = ri - gap;
+                let ai = if T::FRICTION { lever.arm(ri, dn) } else { 0.0 };
+                let spin = if T::FRICTION { ai * p.omega[i] } else { 0.0 };
+                let input = ContactInput { n, dn, r_star: ri, sqrt_m_star: p.m[i].sqrt(), v_rel: p.v[i] - wall.v, spin, dt, tangential_scale: 1.0 };
+                let pm = w.pair_table.get(p.material[i] as usize, wall.material);
+                let c = model.touch::<ENERGY>(&input, pm, h, &mut w.ledger);
+                active[i] = true;
+                p.f[i] += c.force;
+                on_wall -= c.force;
+                if T::FRICTION {
+                    p.torque[i] -= lever.wall_torque_arm(ri, dn) * cross(n, c.tangential);
+                }
+                if dn / ri > worst.0 {
+                    worst = (dn / ri, i, usize::MAX - k);
+                }
+            }
+            wall.force = on_wall;
+        }
+        w.max_overlap = worst;
+        Ok(())
+    }
+}
+
+/// Sum the force on rough walls, account for the walls' work, and give a loaded wall
+/// its second half kick.
+pub struct FinishWalls<const ENERGY: bool>;
+
+impl<L: ContactLaw, const ENERGY: bool> Stage<L> for FinishWalls<ENERGY> {
+    fn name(&self) -> String {
+        "WallForces".into()
+    }
+    fn run(&mut self, w: &mut World<L>) -> Result<(), Error> {
+        let dt = w.dt;
+        for wall in &mut w.walls {
+            if let Surface::Rough { grains } = &wall.surface {
+                wall.force = grains.clone().map(|k| w.p.f[k]).sum();
+            }
+            if ENERGY {
+                // Work of the wall's prescribed motion on the grains over this step
+                // (trapezoid); a loaded wall's y motion is its own dynamics, and the load
+                // does the work there.
+                let d = wall.v * dt;
+                let f = 0.5 * (wall.force_prev + wall.force);
+                match wall.control {
+                    Control::Fixed => w.ledger.walls -= f.dot(&d),
+                    Control::Load { .. } => {
+                        w.ledger.walls -= f.x * d.x;
+                        w.ledger.load += wall.load_y() * d.y;
+                    }
+                }
+            }
+            wall.force_prev = wall.force;
+            if let Control::Load { .. } = wall.control {
+                wall.v.y += 0.5 * dt * (wall.force.y + wall.load_y()) / wall.mass;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Stop a run that has gone wrong, with a diagnosis.
+pub struct Watchdog {
+    /// Largest overlap allowed, as a fraction of the smaller radius.
+    pub max_overlap: f64,
+    /// Check for non-finite state every this many steps.
+    pub every: u64,
+}
+
+impl<L: ContactLaw> Stage<L> for Watchdog {
+    fn name(&self) -> String {
+        format!("Watchdog(overlap < {} r)", self.max_overlap)
+    }
+    fn run(&mut self, w: &mut World<L>) -> Result<(), Error> {
+        let (ratio, i, j) = w.max_overlap;
+        if ratio > self.max_overlap {
+            let what = if j > w.p.len() {
+                format!("grain {i} overlaps the {} wall by {:.3} of its radius (bound {})", w.walls[usize::MAX - j].name, ratio, self.max_overlap)
+            } else {
+                format!("grains {i} and {j} overlap by {:.3} of the smaller radius (bound {})", ratio, self.max_overlap)
+            };
+            return Err(w.unstable_at(what, Some(i)));
+        }
+        if w.step.is_multiple_of(self.every) {
+            // The velocities as they are at the end of the step.
+            crate::engine::integrate::settle(w);
+            w.check_finite()?;
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,186 @@
+//! Choosing the time step, and the stability limit it must respect.
+//!
+//! The reference contact for every estimate is the most demanding one a scene has: the
+//! smallest grain against another like it, and against a flat wall when there is one.
+//! - Hertz contact time at speed v: `t_c = 2.868 (m*^2 / (R* E*^2 v))^(1/5)`.
+//! - Stability of velocity Verlet: `dt < 2 / omega_max`, with `omega_n^2 = Sn / m*` and,
+//!   with friction, `omega_t^2 = kt (1/m_i + 1/m_j + a_i^2/I_i + a_j^2/I_j)`, both
+//!   stiffnesses taken at the maximum overlap of an impact at the characteristic speed.
+//! - Rayleigh time of the smallest grain: `pi r sqrt(rho/G) / (0.1631 nu + 0.8766)`.
+
+use serde::Serialize;
+
+use crate::error::{Error, check};
+use crate::physics::contact::normal::HertzStiffness;
+use crate::physics::material::{Material, PairMaterial, hertz_contact_time, hertz_max_overlap, rayleigh_time};
+use crate::scene::TimeStepRule;
+
+/// A reference contact: reduced radius and mass, the pair's moduli, and the inverse
+/// tangential mass of the contact point.
+#[derive(Clone, Copy, Debug)]
+pub struct RefContact {
+    pub r_star: f64,
+    pub m_star: f64,
+    pub pair: PairMaterial,
+    /// 1/m_i + 1/m_j + a_i^2/I_i + a_j^2/I_j, 1/kg.
+    pub inv_tangential_mass: f64,
+}
+
+impl RefContact {
+    /// Two like grains of radius `r`, mass `m` and moment of inertia `i`, of one material
+    /// (`pair` mixes it with itself).
+    pub fn twin(r: f64, m: f64, i: f64, pair: PairMaterial) -> Self {
+        RefContact { r_star: r / 2.0, m_star: m / 2.0, pair, inv_tangential_mass: 2.0 / m + 2.0 * r * r / i }
+    }
+    /// Two grains `a` and `b`, each (radius, mass, moment of inertia), whose materials
+    /// `pair` mixes.
+    pub fn grains(a: (f64, f64, f64), b: (f64, f64, f64), pair: PairMaterial) -> Self {
+        RefContact {
+            r_star: crate::physics::material::reduced(a.0, b.0),
+            m_star: crate::physics::material::reduced(a.1, b.1),
+            pair,
+            inv_tangential_mass: 1.0 / a.1 + 1.0 / b.1 + a.0 * a.0 / a.2 + b.0 * b.0 / b.2,
+        }
+    }
+    /// A grain of radius `r`, mass `m`, moment of inertia `i` against a flat wall (R* = r,
+    /// m* = m).
+    pub fn wall(r: f64, m: f64, i: f64, pair: PairMaterial) -> Self {
+        RefContact { r_star: r, m_star: m, pair, inv_tangential_mass: 1.0 / m + r * r / i }
+    }
+}
+
+/// The chosen time step and what it means.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct TimeStepInfo {
+    /// Time step, s.
+    pub dt_s: f64,
+    /// Hertz contact time of the reference contact at the characteristic speed, s.
+    pub contact_time_s: f64,
+    /// Steps per contact, t_c / dt.
+    pub steps_per_contact: f64,
+    /// Stability limit 2 / omega_max, s.
+    pub stability_limit_s: f64,
+    /// Rayleigh time of the smallest grain, s.
+    pub rayleigh_time_s: f64,
+    /// Speed used for t_c and the stability limit, m/s.
+    pub characteristic_speed_m_s: f64,
+    /// The accuracy target that chose dt, if the rule was `accuracy`.
+    pub accuracy: Option<AccuracyNote>,
+}
+
+/// Contact time, stability limit over the reference contacts at speed `v`.
+fn limits(refs: &[RefContact], v: f64, friction: bool) -> (f64, f64) {
+    let mut tc = f64::INFINITY;
+    let mut omega: f64 = 0.0;
+    for c in refs {
+        tc = tc.min(hertz_contact_time(c.m_star, c.r_star, c.pair.e_star, v));
+        let dmax = hertz_max_overlap(c.m_star, c.r_star, c.pair.e_star, v);
+        let s = HertzStiffness::new(c.pair.e_star, c.pair.g_star, c.r_star, dmax);
+        omega = omega.max((s.sn / c.m_star).sqrt());
+        if friction {
+            omega = omega.max((s.kt * c.inv_tangential_mass).sqrt());
+        }
+    }
+    (tc, 2.0 / omega)
+}
+
+/// The stability limit 2 / omega_max over the contacts `refs` at speed `v`, s.
+pub fn stability_limit(refs: &[RefContact], v: f64, friction: bool) -> f64 {
+    limits(refs, v, friction).1
+}
+
+/// Apply the rule. `smallest` is the smallest grain's (radius, mass, material).
+pub fn choose(
+    rule: &TimeStepRule,
+    characteristic_speed: Option<f64>,
+    allow_unstable: bool,
+    refs: &[RefContact],
+    smallest: (f64, f64, &Material),
+    friction: bool,
+) -> Result<TimeStepInfo, Error> {
+    let v = characteristic_speed.unwrap_or(match rule {
+        TimeStepRule::StepsPerContact { impact_speed, .. } | TimeStepRule::Accuracy { impact_speed, .. } => *impact_speed,
+        _ => 1.0,
+    });
+    let (tc, limit) = limits(refs, v, friction);
+    let rayleigh = rayleigh_time(smallest.0, smallest.2);
+    // Moduli, densities or speeds at the edge of the floating-point range give a contact
+    // time or limit of 0 or infinity, from which no time step follows.
+    let positive = |t: f64| t.is_finite() && t > 0.0;
+    if !(positive(tc) && positive(limit) && positive(rayleigh)) {
+        return Err(Error::Invalid {
+            field: "time_step".into(),
+            value: format!("t_c = {tc:e} s, stability limit {limit:e} s, Rayleigh time {rayleigh:e} s of the smallest grain at {v} m/s"),
+            allowed: "materials (moduli, densities), radii and speeds whose contact time scales are finite and > 0".into(),
+        });
+    }
+    let dt = match *rule {
+        TimeStepRule::Fixed { dt } => dt,
+        TimeStepRule::StepsPerContact { steps, impact_speed } => limits(refs, impact_speed, friction).0 / steps,
+        TimeStepRule::Accuracy { .. } => unreachable!("build() calibrates an accuracy rule into steps per contact first"),
+        TimeStepRule::RayleighFraction { fraction } => fraction * rayleigh,
+        TimeStepRule::SeedRule { factor, reference_overlap } => {
+            let dn = reference_overlap * smallest.0;
+            let k_max = refs.iter().map(|c| HertzStiffness::new(c.pair.e_star, c.pair.g_star, c.r_star, dn).kn).fold(0.0, f64::max);
+            factor * 2.0 * (smallest.1 / k_max).sqrt()
+        }
+    };
+    if !allow_unstable {
+        check(
+            dt <= limit,
+            "time_step",
+            "dt",
+            format!("{dt:.4e} s"),
+            &format!(
+                "<= {limit:.4e} s, the stability limit at {v} m/s (t_c = {tc:.4e} s; use more steps per contact, or set time_step.allow_unstable)"
+            ),
+        )?;
+    }
+    Ok(TimeStepInfo {
+        dt_s: dt,
+        contact_time_s: tc,
+        steps_per_contact: tc / dt,
+        stability_limit_s: limit,
+        rayleigh_time_s: rayleigh,
+        characteristic_speed_m_s: v,
+        accuracy: None,
+    })
+}
+
+/// Steps of a run of `duration` s at `dt`, and the steps per output sample: the schedule
+/// every run follows, and that exported decks and calibrations copy.
+pub fn schedule(duration: f64, dt: f64, samples: u64) -> (u64, u64) {
+    let total = steps_of(duration, dt) as u64;
+    (total, (total / samples.max(1)).max(1))
+}
+
+/// The steps a run of `duration` s takes at `dt` (at least one), as a float: NaN or
+/// infinite for a dt that is not finite and > 0 ([`step_count`] refuses those).
+fn steps_of(duration: f64, dt: f64) -> f64 {
+    (duration / dt).ceil().max(1.0)
+}
+
+/// The steps of a run of `duration` s at `dt`, refused when dt is not finite and > 0 or
+/// the count exceeds [`crate::scene::limits::MAX_STEPS`] (`field` names what set the duration).
+pub fn step_count(duration: f64, dt: f64, field: &str) -> Result<u64, Error> {
+    let steps = steps_of(duration, dt);
+    if !(dt.is_finite() && dt > 0.0) {
+        return Err(Error::Invalid { field: "time_step".into(), value: format!("dt = {dt:e} s"), allowed: "a rule that gives a finite dt > 0 s (check the materials' moduli and densities and the speeds)".into() });
+    }
+    if !(steps <= crate::scene::limits::MAX_STEPS) {
+        return Err(Error::Invalid {
+            field: field.into(),
+            value: format!("{duration} s"),
+            allowed: format!("at most {:e} steps of dt = {dt:.3e} s (it asks for {steps:.3e}): a shorter duration or a larger time step", crate::scene::limits::MAX_STEPS),
+        });
+    }
+    Ok(steps as u64)
+}
+
+/// What the calibration chose, as reported with the time step.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct AccuracyNote {
+    pub quantity: crate::scene::AccuracyQuantity,
+    pub tolerance: f64,
+    pub measured_error: f64,
+}

@@ -1,0 +1,230 @@
+//! The world: everything that evolves (grains, contacts, walls, the integrator's
+//! factors), the [`Stage`] trait of what acts on it once per step, and the read-only
+//! [`View`] that observers and outputs get. The pipeline that runs the stages is
+//! [`crate::engine::simulation`].
+
+use crate::engine::neighbor::Neighbours;
+use crate::error::Error;
+use crate::kernels::pairs::PairList;
+use crate::physics::boundary::Boundary;
+use crate::physics::contact::tangential::Tangential;
+use crate::physics::contact::{ContactHistory, ContactLaw};
+use crate::physics::dim::Vec2;
+use crate::physics::energy::{EnergyLedger, EnergyRow};
+use crate::physics::material::PairTable;
+use crate::physics::particles::Particles;
+use crate::physics::walls::Wall;
+
+/// History type of a contact law.
+pub type Hist<L> = ContactHistory<<<L as ContactLaw>::Tang as Tangential>::History<f64>>;
+
+/// Everything that evolves.
+pub struct World<L: ContactLaw> {
+    pub p: Particles,
+    pub boundary: Boundary,
+    pub law: L,
+    pub pair_table: PairTable,
+    pub pairs: PairList<<L::Tang as Tangential>::History<f64>>,
+    pub walls: Vec<Wall>,
+    /// History of each free grain against each flat wall: `wall_hist[wall][grain]`.
+    pub wall_hist: Vec<Vec<Hist<L>>>,
+    /// Whether each free grain is touching each flat wall: `wall_active[wall][grain]`.
+    pub wall_active: Vec<Vec<bool>>,
+    pub neighbours: Neighbours,
+    pub ledger: EnergyLedger,
+    pub gravity: Vec2,
+    /// Time step, s.
+    pub dt: f64,
+    /// Steps done.
+    pub step: u64,
+    /// Largest overlap of this step as a fraction of the smaller radius, and where.
+    pub max_overlap: (f64, usize, usize),
+    /// Energy in the system at the start, J.
+    pub initial_energy: f64,
+    /// The energy ledger is kept (the kernels were compiled with it).
+    pub energy: bool,
+    /// The threads the per-grain stages and the contact stage may use.
+    pub threads: crate::kernels::threads::Threads,
+    /// The half-kick factors of the integrator.
+    pub kick: KickFactors,
+    /// The region the grains must stay in ([`crate::engine::domain`]).
+    pub domain: crate::engine::domain::Domain,
+    /// What the build knew that helps diagnose a failed run.
+    pub context: crate::engine::domain::Context,
+    /// How many of the first grains have zero forces (and torques) already this step:
+    /// the drift sets the free grains' to zero once it has used them, and
+    /// [`crate::engine::stages::ClearForces`] clears the rest (then sets these back to 0).
+    pub zeroed: Zeroed,
+}
+
+impl<L: ContactLaw> World<L> {
+    pub fn time(&self) -> f64 {
+        self.step as f64 * self.dt
+    }
+    /// Kinetic energies (translation, rotation, walls), J.
+    pub fn kinetic(&self) -> (f64, f64, f64) {
+        (self.p.kinetic_translation(), self.p.kinetic_rotation(), self.walls.iter().map(Wall::kinetic).sum())
+    }
+    pub fn energy_row(&self) -> EnergyRow {
+        EnergyRow::new(self.time(), self.kinetic(), &self.ledger, self.initial_energy)
+    }
+    /// A full check of the state, O(N): every grain finite, and (with the energy ledger)
+    /// no energy created: the balance residual under [`MAX_RESIDUAL`] of the energy put
+    /// in. The run loop calls it at every output sample and at the end of a run.
+    pub fn health(&self) -> Result<(), Error> {
+        let p = &self.p;
+        self.check_finite()?;
+        if self.energy {
+            let row = self.energy_row();
+            if let Some(term) = crate::finite::non_finite_column(&row) {
+                return Err(self.unstable(format!("the energy balance's {term} is no longer finite")));
+            }
+            let scale = row.put_in();
+            if scale > 0.0 && row.residual_j.abs() > MAX_RESIDUAL * scale {
+                let fastest = (0..p.n_free).max_by(|&a, &b| p.v[a].norm_squared().total_cmp(&p.v[b].norm_squared())).unwrap_or(0);
+                return Err(self.unstable(format!(
+                    "the energy balance no longer closes: residual {:.3e} J is {:.1}% of the energy put in ({:.3e} J); the fastest grain, {fastest}, moves at {:.3e} m/s",
+                    row.residual_j,
+                    100.0 * row.residual_j.abs() / scale,
+                    scale,
+                    p.v[fastest].norm()
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// An error naming the first free grain whose position, velocity, spin or force is not
+    /// finite (or whose kinetic energy overflows), or a wall whose state is not.
+    pub fn check_finite(&self) -> Result<(), Error> {
+        let p = &self.p;
+        let bad = |i: usize| !(p.x[i].x.is_finite() && p.x[i].y.is_finite() && p.v[i].norm_squared().is_finite() && p.omega[i].is_finite() && (p.omega[i] * p.omega[i]).is_finite());
+        if let Some(i) = (0..p.n_free).find(|&i| bad(i)) {
+            return Err(self.unstable_at(format!("grain {i} has a non-finite position, velocity or spin (x = {:?}, v = {:?}, omega = {})", p.x[i], p.v[i], p.omega[i]), Some(i)));
+        }
+        if let Some(w) = self.walls.iter().find(|w| !(w.y.is_finite() && w.v.norm_squared().is_finite() && w.force.norm_squared().is_finite())) {
+            return Err(self.unstable_at(format!("the {} wall's position, velocity or force is not finite", w.name), None));
+        }
+        Ok(())
+    }
+
+    /// The domain's check at a neighbour-list rebuild ([`crate::engine::domain::Domain::check`]).
+    pub fn check_domain(&self) -> Result<(), Error> {
+        use crate::engine::domain::Fault;
+        let fault = self.domain.check(&self.p, &self.walls, self.neighbours.at_build(), &self.boundary, 0.5 * self.neighbours.skin);
+        let Some(fault) = fault else { return Ok(()) };
+        let p = &self.p;
+        let who = |i: usize| if i < p.n_free { format!("grain {i}") } else { format!("grain {i} (glued to a rough wall)") };
+        Err(match fault {
+            Fault::Left { grain, at } => self.unstable_at(
+                format!("{} left the domain: it is at ({:.6e}, {:.6e}) m, moving at {:.3e} m/s", who(grain), at.x, at.y, p.v[grain].norm()),
+                Some(grain),
+            ),
+            Fault::Jumped { grain, moved } => self.unstable_at(
+                format!(
+                    "{} moved {moved:.3e} m in one step ({:.3} of the smallest radius, more than {}); it moves at {:.3e} m/s",
+                    who(grain),
+                    moved / self.p.r[..p.n_free].iter().cloned().fold(f64::INFINITY, f64::min),
+                    crate::engine::consistency::MAX_STEP_MOVE,
+                    p.v[grain].norm()
+                ),
+                Some(grain),
+            ),
+            Fault::WallsCrossed { gap } => self.unstable_at(format!("the top wall's contact surface came down to the bottom wall's (gap {gap:.3e} m)"), None),
+            Fault::WallEscaped { y } => self.unstable_at(format!("the top wall rose to y = {y:.6e} m, ten gaps above where it started"), None),
+        })
+    }
+
+    pub(crate) fn unstable(&self, what: String) -> Error {
+        self.unstable_at(what, None)
+    }
+
+    /// A diagnosed stop: what went wrong (with grain `grain` to blame, if one is) and the
+    /// likely cause ([`crate::engine::domain::Context::likely_cause`]).
+    pub(crate) fn unstable_at(&self, what: String, grain: Option<usize>) -> Error {
+        Error::Unstable {
+            step: self.step,
+            time: self.time(),
+            what,
+            advice: self.context.likely_cause(&self.p, &self.walls, self.gravity, self.dt, self.time(), grain, self.domain.max_step),
+        }
+    }
+}
+
+/// The grains `0..forces` have zero forces, `0..torques` zero torques ([`World::zeroed`]).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Zeroed {
+    pub forces: usize,
+    pub torques: usize,
+}
+
+/// Largest energy balance residual, as a fraction of the energy put in, before a run is
+/// stopped: 50%. A stable run at 25 steps per contact shows 3e-3, and an impact at the
+/// very edge of the stability limit (3.7 steps per contact) 12%; an unstable integration
+/// creates many times the energy put in within a few steps.
+pub const MAX_RESIDUAL: f64 = 0.5;
+
+/// A read-only view of a world's state at one time: what observers and outputs read
+/// (they see neither the World nor the Engine).
+#[derive(Clone, Copy)]
+pub struct View<'a> {
+    pub particles: &'a Particles,
+    pub walls: &'a [Wall],
+    pub boundary: Boundary,
+    /// Simulated time, s.
+    pub time: f64,
+}
+
+/// One stage of a time step.
+pub trait Stage<L: ContactLaw>: Send {
+    fn name(&self) -> String;
+    fn run(&mut self, w: &mut World<L>) -> Result<(), Error>;
+}
+
+/// The half-kick factors `dt/2 / m` and `dt/2 / I` of the free grains, divided out once
+/// per time step value instead of at every step (the same division, so the same bits as
+/// LIGGGHTS' `dtfm = dtf / rmass[i]`). One set per world (`World::kick`), shared by both
+/// half kicks.
+#[derive(Default)]
+pub struct KickFactors {
+    dt: f64,
+    /// dt/2 / m, s/kg.
+    pub dtfm: Vec<f64>,
+    /// dt/2 / m twice per grain, s/kg: the factor of each component of a grain's
+    /// velocity, as the velocities are stored (x, y). A kick or drift over the
+    /// components is then element by element, which compilers vectorise without
+    /// splitting the (x, y) pairs into an x and a y register and back.
+    pub dtfm2: Vec<Vec2>,
+    /// dt/2 / I, s/(kg m^2).
+    pub dtfi: Vec<f64>,
+    /// Leave this step's final half kick to the next drift: nothing looks at the grains'
+    /// velocities before it ([`crate::engine::simulation::Simulation::advance`] sets it).
+    pub defer: bool,
+    /// The final half kick left to the next drift, if any: for time step `dt`, s, and
+    /// with the spins (`spin`) or not. Until the drift (or [`crate::engine::integrate::settle`]) gives it, the free
+    /// grains' velocities and spins are half a kick behind.
+    pub pending: Option<PendingKick>,
+}
+
+/// A final half kick not given yet ([`KickFactors::pending`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PendingKick {
+    /// Time step of the step it ends, s.
+    pub dt: f64,
+    /// It kicks the spins too.
+    pub spin: bool,
+}
+
+impl KickFactors {
+    /// Recompute for time step `dt` if it (or the number of free grains) changed.
+    pub fn update(&mut self, p: &Particles, dt: f64) {
+        let n = p.n_free;
+        if self.dt != dt || self.dtfm.len() != n {
+            let dtf = 0.5 * dt;
+            self.dt = dt;
+            self.dtfm = p.m[..n].iter().map(|m| dtf / m).collect();
+            self.dtfm2 = self.dtfm.iter().map(|&m| Vec2::new(m, m)).collect();
+            self.dtfi = p.inertia[..n].iter().map(|i| dtf / i).collect();
+        }
+    }
+}

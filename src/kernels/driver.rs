@@ -1,0 +1,319 @@
+//! The contact kernel driver: each touching pair's input gathered from the grains'
+//! slices, the contact law run one pair or four in SIMD lanes with the same bits, each
+//! pair's force and torque handed to a sink in list order, the energy terms summed in
+//! the serial order. It reads a view of the grains ([`PairView`]) and the list's slices
+//! ([`PairSlices`]): no World, no Engine. Uses physics and the pair list.
+
+use nalgebra::Vector2;
+use simba::simd::{SimdBool, SimdPartialOrd, SimdValue};
+use crate::kernels::pairs::{CheckedPairs, PairConst};
+use crate::physics::boundary::Boundary;
+use crate::physics::contact::damping::Damping;
+use crate::physics::contact::tangential::Tangential;
+use crate::physics::contact::{ContactInput, ContactLaw, ContactModel, EnergyMemory, EnergyTerms, LeverArm};
+use crate::physics::dim::{Vec2, cross};
+use crate::physics::energy::EnergyLedger;
+use crate::physics::lanes::{LANES, Lanes, Real, gather, gather2, lane2};
+use crate::physics::material::PairMaterial;
+use crate::physics::particles::Particles;
+
+/// What one grain-grain pair did this step, for the grains to collect.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct PairOut {
+    /// Force on the first grain (the second gets the opposite), N.
+    pub force: Vec2,
+    /// Torques to subtract from the first and the second grain, N m.
+    pub torque: [f64; 2],
+    /// Overlap over the smaller radius (0 when not touching).
+    pub ratio: f64,
+}
+
+/// The contact input of touching pairs (one, or one per lane) from their separation
+/// `d` (minimum image, i minus j), radii, spins (unread without `SPIN`: the grains do not
+/// rotate), relative velocity and constants.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn pair_input<R: Real, T: Tangential, const SPIN: bool>(lever: LeverArm, d: Vector2<R>, ri: R, rj: R, wi: R, wj: R, v_rel: Vector2<R>, r_star: R, sqrt_m_star: R, dt: R) -> ContactInput<R> {
+    let radsum = ri + rj;
+    let r = d.norm_squared().simd_sqrt();
+    let n = d * r.simd_recip();
+    let dn = radsum - r;
+    let spin = if T::FRICTION && SPIN { lever.arm(ri, dn) * wi + lever.arm(rj, dn) * wj } else { R::zero() };
+    let tangential_scale = if T::FRICTION { lever.translation_scale(radsum, dn) } else { R::one() };
+    ContactInput { n, dn, r_star, sqrt_m_star, v_rel, spin, dt, tangential_scale }
+}
+
+/// The torques `-a n x Ft` to subtract from grains i and j.
+#[inline(always)]
+fn pair_torque<R: Real>(lever: LeverArm, c: &ContactInput<R>, ft: Vector2<R>, ri: R, rj: R) -> [R; 2] {
+    let t = cross(c.n, ft);
+    [lever.torque_arm(ri, c.dn) * t, lever.torque_arm(rj, c.dn) * t]
+}
+
+/// One pair of the Verlet list: the contact force (touching), the end of a contact
+/// (released), or nothing; tangential state `h`, energy memory `e` (with `ENERGY`) and
+/// energy terms updated.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+pub fn pair_contact<Dm: Damping, T: Tangential, const ENERGY: bool>(
+    w: &PairView<'_, ContactModel<Dm, T>>,
+    pair: [u32; 2],
+    pc: &PairConst,
+    h: &mut T::History<f64>,
+    e: &mut EnergyMemory,
+    active: &mut bool,
+    ledger: &mut EnergyLedger,
+) -> PairOut {
+    let model = w.law;
+    let p = w.p;
+    let (i, j) = (pair[0] as usize, pair[1] as usize);
+    let d = w.boundary.image(p.x[i] - p.x[j]);
+    let rsq = d.norm_squared();
+    let (ri, rj) = (p.r[i], p.r[j]);
+    let radsum = ri + rj;
+    if rsq >= radsum * radsum {
+        if *active {
+            let n = d / rsq.sqrt();
+            let spin = if T::FRICTION { ri * p.omega[i] + rj * p.omega[j] } else { 0.0 };
+            let vc = p.v[i] - p.v[j] + spin * Vec2::new(n.y, -n.x);
+            model.release::<ENERGY>(vc, n, w.dt, h, e, ledger);
+            *active = false;
+        }
+        return PairOut::default();
+    }
+    let (o, pend) = one_pair::<Dm, T, true>(w, (i, j), d, pc, h, active);
+    if ENERGY {
+        model.account(pend.n, pend.dn, w.dt, &pend.state, e, ledger);
+    }
+    o
+}
+
+/// Four touching pairs at once, one per SIMD lane (`ks`: their indices in the list, `ds`
+/// their separations): the same bits as [`one_pair`] gives each of them, handed to
+/// `sink` (index in the part, grains, output) in lane order; with `ENERGY`, their energy
+/// terms (also in lanes, their energy memories moved on) go to `pending`. Without `SPIN`
+/// (grains that do not rotate) the spins are not read and the torques not computed.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn four_pairs<Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN: bool>(
+    w: &PairView<'_, ContactModel<Dm, T>>,
+    list: PairSlices<'_, T>,
+    single: Option<&PairMaterial<Lanes>>,
+    ks: &[u32],
+    ds: &[Vec2],
+    sink: &mut impl FnMut(usize, (usize, usize), PairOut),
+    pending: &mut [EnergyTerms],
+    best: &mut (f64, usize),
+) {
+    let (model, p) = (w.law, w.p);
+    let lever = model.options.lever_arm;
+    // The per-pair slices cut to one length, so that one bounds check per index serves
+    // them all; the per-grain arrays are read through the checked list, with none.
+    let np = list.pairs.len();
+    let (pairs, consts, hist, active) = (list.pairs.pairs(), &list.consts[..np], &mut list.hist[..np], &mut list.active[..np]);
+    let (v, r, omega) = (list.pairs.of(&p.v), list.pairs.of(&p.r), list.pairs.of(&p.omega));
+    let ks: [usize; LANES] = std::array::from_fn(|l| ks[l] as usize);
+    let ij: [(usize, usize); LANES] = std::array::from_fn(|l| {
+        let q = pairs[ks[l]];
+        (q[0] as usize, q[1] as usize)
+    });
+    let pc: [&PairConst; LANES] = std::array::from_fn(|l| &consts[ks[l]]);
+    let d = gather2(|l| ds[l]);
+    let rs: [(f64, f64); LANES] = std::array::from_fn(|l| r.at(ks[l]));
+    let (ri, rj) = (gather(|l| rs[l].0), gather(|l| rs[l].1));
+    let (wi, wj) = if T::FRICTION && SPIN {
+        let ws: [(f64, f64); LANES] = std::array::from_fn(|l| omega.at(ks[l]));
+        (gather(|l| ws[l].0), gather(|l| ws[l].1))
+    } else {
+        (Lanes::splat(0.0), Lanes::splat(0.0))
+    };
+    let v_rel = gather2(|l| {
+        let (vi, vj) = v.at(ks[l]);
+        vi - vj
+    });
+    let input = pair_input::<Lanes, T, SPIN>(lever, d, ri, rj, wi, wj, v_rel, gather(|l| pc[l].r_star), gather(|l| pc[l].sqrt_m_star), Lanes::splat(w.dt));
+    let pm = match single {
+        Some(pm) => *pm,
+        None => {
+            let mat = list.pairs.of(&p.material);
+            PairMaterial::gather(std::array::from_fn(|l| {
+                let (mi, mj) = mat.at(ks[l]);
+                w.pair_table.get(mi as usize, mj as usize)
+            }))
+        }
+    };
+    let mut h = T::gather(std::array::from_fn(|l| &hist[ks[l]]));
+    let c = model.force(&input, &pm, &mut h);
+    let torque = if T::FRICTION && SPIN { pair_torque(lever, &input, c.tangential.elastic + c.tangential.damping, ri, rj) } else { [Lanes::splat(0.0); 2] };
+    let ratio = input.dn * gather(|l| pc[l].inv_r_min);
+    // The largest overlap so far: a lane beats it rarely, so one test per four pairs.
+    let beats = ratio.simd_gt(Lanes::splat(best.0)).bitmask();
+    if beats != 0 {
+        for (l, &k) in ks.iter().enumerate() {
+            if ratio.extract(l) > best.0 {
+                *best = (ratio.extract(l), k);
+            }
+        }
+    }
+    // With the ledger, the energy terms too, in lanes; the ledger adds them later in
+    // list order.
+    let terms = if ENERGY {
+        let mut e = EnergyMemory::gather(std::array::from_fn(|l| &list.energy[ks[l]]));
+        let t = model.energy_terms(input.n, input.dn, input.dt, &c, &mut e);
+        for (l, &k) in ks.iter().enumerate() {
+            list.energy[k] = e.lane(l);
+        }
+        t
+    } else {
+        EnergyTerms::default()
+    };
+    for l in 0..LANES {
+        hist[ks[l]] = T::lane(&h, l);
+        active[ks[l]] = true;
+        sink(ks[l], ij[l], PairOut { force: lane2(&c.force, l), torque: [torque[0].extract(l), torque[1].extract(l)], ratio: ratio.extract(l) });
+        if ENERGY {
+            pending[l] = terms.lane(l);
+        }
+    }
+}
+
+/// One touching pair of grains `(i, j)` at separation `d` (minimum image, i minus j):
+/// its force, advancing its tangential state `h`, and what its energy accounting needs.
+#[inline(always)]
+fn one_pair<Dm: Damping, T: Tangential, const SPIN: bool>(
+    w: &PairView<'_, ContactModel<Dm, T>>,
+    (i, j): (usize, usize),
+    d: Vec2,
+    pc: &PairConst,
+    h: &mut T::History<f64>,
+    active: &mut bool,
+) -> (PairOut, Touch) {
+    let (model, p) = (w.law, w.p);
+    let lever = model.options.lever_arm;
+    let input = pair_input::<f64, T, SPIN>(lever, d, p.r[i], p.r[j], p.omega[i], p.omega[j], p.v[i] - p.v[j], pc.r_star, pc.sqrt_m_star, w.dt);
+    let pm = w.pair_table.get(p.material[i] as usize, p.material[j] as usize);
+    let c = model.force(&input, pm, h);
+    *active = true;
+    let torque = if T::FRICTION && SPIN { pair_torque(lever, &input, c.tangential.elastic + c.tangential.damping, p.r[i], p.r[j]) } else { [0.0, 0.0] };
+    (PairOut { force: c.force, torque, ratio: input.dn * pc.inv_r_min }, Touch { n: input.n, dn: input.dn, state: c })
+}
+
+/// What a touching pair's energy accounting needs: the normal, the overlap (m), and the
+/// step's contact state.
+#[derive(Clone, Copy, Debug, Default)]
+struct Touch {
+    n: Vec2,
+    dn: f64,
+    state: crate::physics::contact::model::ContactState,
+}
+
+/// A part of the pair list: the pairs, their constants, tangential states, energy
+/// memories (empty without the energy ledger) and touching flags.
+pub struct PairSlices<'a, T: Tangential> {
+    pub pairs: CheckedPairs<'a>,
+    pub consts: &'a [PairConst],
+    pub hist: &'a mut [T::History<f64>],
+    pub energy: &'a mut [EnergyMemory],
+    pub active: &'a mut [bool],
+}
+
+/// Where the energy terms of the pairs go: the world's ledger (serial order), or one
+/// ledger per pair of the list part (merged in list order later).
+pub enum Ledgers<'a> {
+    One(&'a mut EnergyLedger),
+    PerPair(&'a mut [EnergyLedger]),
+}
+
+impl Ledgers<'_> {
+    /// The same ledgers, for a shorter while.
+    pub fn reborrow(&mut self) -> Ledgers<'_> {
+        match self {
+            Ledgers::One(l) => Ledgers::One(l),
+            Ledgers::PerPair(v) => Ledgers::PerPair(v),
+        }
+    }
+    #[inline(always)]
+    fn get(&mut self, k: usize) -> &mut EnergyLedger {
+        match self {
+            Ledgers::One(l) => l,
+            Ledgers::PerPair(v) => &mut v[k],
+        }
+    }
+}
+
+/// Compute the pairs `touching` and `released` of a list part (indices from
+/// [`crate::kernels::sweep::sort_pairs`]): the output of each touching pair goes to `sink` (its index in the
+/// part, its grains and its output), in list order. The touching pairs run four at a
+/// time in SIMD lanes, their energy terms too (with the energy ledger); the ledger then
+/// adds those and the released pairs' in list order, so that it sums in the serial
+/// order; `pending` holds the terms meanwhile. Returns the largest overlap over the
+/// smaller radius of the touching pairs and the index (in the part) of the first pair
+/// that has it, `(0, usize::MAX)` if none touches.
+#[allow(clippy::too_many_arguments)]
+pub fn compute_pairs<Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN: bool>(
+    w: &PairView<'_, ContactModel<Dm, T>>,
+    list: PairSlices<'_, T>,
+    touching: &[u32],
+    sep: &[Vec2],
+    released: &[u32],
+    mut ledgers: Ledgers<'_>,
+    mut sink: impl FnMut(usize, (usize, usize), PairOut),
+    pending: &mut Vec<EnergyTerms>,
+) -> (f64, usize) {
+    let mut best = (0.0, usize::MAX);
+    if ENERGY && pending.len() < touching.len() {
+        pending.resize(touching.len(), EnergyTerms::default());
+    }
+    let quads = touching.len() / LANES * LANES;
+    // One material: its lanes once, not a table lookup per lane.
+    let single = w.pair_table.single().map(|m| PairMaterial::gather([m; LANES]));
+    let PairSlices { pairs, consts, hist, energy, active } = list;
+    let mut pend = pending.chunks_exact_mut(LANES);
+    for (ks, ds) in touching[..quads].chunks_exact(LANES).zip(sep.chunks_exact(LANES)) {
+        let slices = PairSlices::<T> { pairs, consts, hist: &mut *hist, energy: &mut *energy, active: &mut *active };
+        four_pairs::<Dm, T, ENERGY, SPIN>(w, slices, single.as_ref(), ks, ds, &mut sink, if ENERGY { pend.next().expect("a slot per pair") } else { &mut [] }, &mut best);
+    }
+    for (m, &k) in touching.iter().enumerate().skip(quads) {
+        let k = k as usize;
+        let [i, j] = pairs.pairs()[k].map(|g| g as usize);
+        let (o, p) = one_pair::<Dm, T, SPIN>(w, (i, j), sep[m], &consts[k], &mut hist[k], &mut active[k]);
+        if o.ratio > best.0 {
+            best = (o.ratio, k);
+        }
+        sink(k, (i, j), o);
+        if ENERGY {
+            pending[m] = w.law.energy_terms(p.n, p.dn, w.dt, &p.state, &mut energy[k]);
+        }
+    }
+    let mut none = EnergyLedger::default();
+    if !ENERGY {
+        for &k in released {
+            let k = k as usize;
+            pair_contact::<Dm, T, false>(w, pairs.pairs()[k], &consts[k], &mut hist[k], &mut EnergyMemory::default(), &mut active[k], &mut none);
+        }
+        return best;
+    }
+    // Both kinds merged in list order: the ledger is a sum.
+    let (mut a, mut b) = (0, 0);
+    while a < touching.len() || b < released.len() {
+        if b == released.len() || (a < touching.len() && touching[a] < released[b]) {
+            let k = touching[a] as usize;
+            w.law.add_terms(&pending[a], ledgers.get(k));
+            a += 1;
+        } else {
+            let k = released[b] as usize;
+            pair_contact::<Dm, T, true>(w, pairs.pairs()[k], &consts[k], &mut hist[k], &mut energy[k], &mut active[k], ledgers.get(k));
+            b += 1;
+        }
+    }
+    best
+}
+
+/// What the pair kernel reads: everything but the forces it produces.
+pub struct PairView<'a, L: ContactLaw> {
+    pub p: &'a Particles,
+    pub boundary: Boundary,
+    pub law: L,
+    pub pair_table: &'a crate::physics::material::PairTable,
+    pub dt: f64,
+}

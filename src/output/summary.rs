@@ -1,0 +1,54 @@
+//! `summary.json`: what a run did (its status, model, pipeline, time step, steps and
+//! timings) and what it measured (the energy balance, an impact, the wall stresses),
+//! and the stage timing table printed after a run.
+
+use serde::Serialize;
+
+use crate::engine::timestep::TimeStepInfo;
+use crate::observe::energy::EnergySummary;
+use crate::observe::impact::ImpactSummary;
+use crate::observe::stress::ShearSummary;
+
+/// The time one stage took over a run, and its share of the step.
+#[derive(Clone, Debug, Serialize)]
+pub struct StageTime {
+    pub stage: String,
+    pub seconds: f64,
+    pub share: f64,
+}
+
+/// A run's summary (`summary.json`, also printed on stdout).
+#[derive(Clone, Debug, Serialize)]
+pub struct Summary {
+    pub scene: String,
+    pub status: String,
+    pub error: Option<String>,
+    pub model: String,
+    pub pipeline: String,
+    pub time_step: TimeStepInfo,
+    pub grains: usize,
+    pub steps: u64,
+    pub simulated_time_s: f64,
+    pub wall_time_s: f64,
+    pub particle_steps_per_s: f64,
+    pub energy: Option<EnergySummary>,
+    pub impact: Option<ImpactSummary>,
+    pub shear: Option<ShearSummary>,
+    pub stage_timing: Vec<StageTime>,
+}
+
+/// The stage timing table as text.
+pub fn timing_table(s: &Summary) -> String {
+    let mut out = format!("{:<28} {:>10} {:>7}\n", "stage", "time (s)", "share");
+    for t in &s.stage_timing {
+        out += &format!("{:<28} {:>10.3} {:>6.1}%\n", t.stage, t.seconds, 100.0 * t.share);
+    }
+    out += &format!(
+        "{} grains x {} steps in {:.2} s: {:.2} M particle-steps/s\n",
+        s.grains,
+        s.steps,
+        s.wall_time_s,
+        s.particle_steps_per_s / 1e6
+    );
+    out
+}

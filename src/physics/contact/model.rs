@@ -1,0 +1,386 @@
+//! A contact model: Hertz normal force, a damping form and a tangential formulation,
+//! composed at compile time. Each named combination is one monomorphized kernel.
+
+use std::marker::PhantomData;
+
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+
+use nalgebra::Vector2;
+
+use super::damping::{Damping, Undamped, Viscoelastic};
+use super::normal::{HertzStiffness, hertz_energy};
+use super::tangential::{Frictionless, IncrementalForce, Tangential, TangentialForce, TangentialInput, TotalDisplacement};
+use crate::physics::dim::Vec2;
+use crate::physics::energy::EnergyLedger;
+use crate::physics::lanes::{Real, k, pick};
+use crate::physics::material::PairMaterial;
+
+/// Which distance from the grain centre the tangential force acts at (torque lever arm,
+/// and the same arm in the contact-point velocity so that work and torque agree).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, JsonSchema, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum LeverArm {
+    /// The grain radius a_i = r_i (the seed).
+    #[default]
+    Radius,
+    /// r_i - dn/2 (LIGGGHTS 3.8).
+    RadiusMinusHalfOverlap,
+    /// YADE 2023's `ScGeom` kinematics with its granular-ratcheting correction: the
+    /// tangential contact velocity uses the full radii for the spins and scales the
+    /// translational part by `(r_i + r_j) / (r_i + r_j - dn)` (pairs); the torque arm is
+    /// r - dn/2 for pairs and r - dn for flat walls (YADE applies a wall force at the
+    /// centre projected onto the wall). Not energy-consistent by design: the work of the
+    /// tangential force and its torque differ by O(dn/r).
+    Yade,
+}
+
+impl LeverArm {
+    /// The arm of the spin in the contact-point velocity, m.
+    #[inline(always)]
+    pub fn arm<R: Real>(self, r: R, dn: R) -> R {
+        match self {
+            LeverArm::Radius | LeverArm::Yade => r,
+            LeverArm::RadiusMinusHalfOverlap => r - k::<R>(0.5) * dn,
+        }
+    }
+    /// The torque arm of a grain-grain contact, m.
+    #[inline(always)]
+    pub fn torque_arm<R: Real>(self, r: R, dn: R) -> R {
+        match self {
+            LeverArm::Radius => r,
+            LeverArm::RadiusMinusHalfOverlap | LeverArm::Yade => r - k::<R>(0.5) * dn,
+        }
+    }
+    /// The torque arm of a grain on a flat wall, m.
+    #[inline(always)]
+    pub fn wall_torque_arm(self, r: f64, dn: f64) -> f64 {
+        match self {
+            LeverArm::Yade => r - dn,
+            _ => self.torque_arm(r, dn),
+        }
+    }
+    /// Factor on the translational part of the tangential velocity of a pair.
+    #[inline(always)]
+    pub fn translation_scale<R: Real>(self, radsum: R, dn: R) -> R {
+        match self {
+            LeverArm::Yade => radsum / (radsum - dn),
+            _ => R::one(),
+        }
+    }
+}
+
+/// Runtime switches of a contact model that cost one predictable branch at most.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ModelOptions {
+    /// Clamp Fn >= 0 (LIGGGHTS `limitForce on`; YADE always). Default off.
+    pub limit_force: bool,
+    pub lever_arm: LeverArm,
+}
+
+/// What the kernel needs of one touching pair (or grain and wall) at one step; with
+/// `R = Lanes`, of four pairs.
+#[derive(Clone, Copy, Debug)]
+pub struct ContactInput<R: Real = f64> {
+    /// Unit normal from j to i (from the wall into grain i).
+    pub n: Vector2<R>,
+    /// Overlap dn > 0, m.
+    pub dn: R,
+    /// Reduced radius R*, m.
+    pub r_star: R,
+    /// Square root of the reduced mass m*, kg^1/2.
+    pub sqrt_m_star: R,
+    /// v_i - v_j at the centres, m/s.
+    pub v_rel: Vector2<R>,
+    /// a_i w_i + a_j w_j: the spin part of the contact-point velocity, m/s.
+    pub spin: R,
+    /// Time step, s.
+    pub dt: R,
+    /// Factor on the translational part of the tangential velocity (1, except for YADE's
+    /// ratcheting correction, [`LeverArm::translation_scale`]).
+    pub tangential_scale: R,
+}
+
+impl<R: Real> ContactInput<R> {
+    /// Relative velocity of the contact points, i relative to j.
+    #[inline(always)]
+    pub fn contact_velocity(&self) -> Vector2<R> {
+        self.v_rel + Vector2::new(self.n.y, -self.n.x) * self.spin
+    }
+}
+
+/// Everything one step of a touching contact computes: the force, and what the energy
+/// accounting reads.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct ContactState<R: Real = f64> {
+    /// Total force on i, N.
+    pub force: Vector2<R>,
+    /// Tangential force on i, elastic and viscous parts.
+    pub tangential: TangentialForce<R>,
+    /// Normal force along n (after the clamp, if any), N.
+    pub normal: R,
+    /// Elastic part of the normal force, kn dn, N.
+    pub elastic_normal: R,
+    /// Normal and tangential stiffness, N/m.
+    pub kn: R,
+    pub kt: R,
+    /// Relative velocity of the contact points, m/s.
+    pub vc: Vector2<R>,
+}
+
+/// The force of one contact on grain i (grain j gets the opposite).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct ContactForce {
+    /// Total force on i, N.
+    pub force: Vec2,
+    /// Tangential part of it, N (for the torques -a n x Ft).
+    pub tangential: Vec2,
+    /// Normal force Fn along n (after the clamp, if any), N.
+    pub normal: f64,
+    /// Normal stiffness kn, N/m (for diagnostics).
+    pub kn: f64,
+}
+
+/// What a contact remembers from step to step. Whether it is touching is kept beside
+/// it, densely ([`crate::kernels::pairs::PairList::active`], `World::wall_active`): the sweep
+/// that looks for contacts ending reads that flag for every listed pair. (The pair list
+/// keeps the two parts in separate arrays, and the energy part only with the energy
+/// ledger on: the force kernel reads and writes the tangential state alone.)
+#[derive(Clone, Copy, Debug, Default)]
+pub struct ContactHistory<H> {
+    /// The tangential formulation's state.
+    pub tangential: H,
+    /// What the energy accounting carries over.
+    pub energy: EnergyMemory,
+}
+
+/// What a contact's energy accounting carries from one step to the next: the previous
+/// values of the terms it integrates by the trapezoid rule.
+/// (`R = Lanes`: of four contacts.)
+#[derive(Clone, Copy, Debug, Default)]
+pub struct EnergyMemory<R: Real = f64> {
+    /// Previous normal damping force (for the trapezoidal energy integrals), N.
+    pub fd_prev: R,
+    /// Previous elastic tangential force, N.
+    pub fte_prev: Vector2<R>,
+    /// Previous tangential damping force, N.
+    pub ftd_prev: Vector2<R>,
+    /// Previous tangential elastic energy, J.
+    pub ut_prev: R,
+}
+
+impl EnergyMemory<crate::physics::lanes::Lanes> {
+    /// Four contacts' memories in lanes.
+    #[inline(always)]
+    pub fn gather(h: [&EnergyMemory; crate::physics::lanes::LANES]) -> Self {
+        use crate::physics::lanes::{gather, gather2};
+        EnergyMemory { fd_prev: gather(|l| h[l].fd_prev), fte_prev: gather2(|l| h[l].fte_prev), ftd_prev: gather2(|l| h[l].ftd_prev), ut_prev: gather(|l| h[l].ut_prev) }
+    }
+    /// The memory in lane `l`.
+    #[inline(always)]
+    pub fn lane(&self, l: usize) -> EnergyMemory {
+        use crate::physics::lanes::lane2;
+        use simba::simd::SimdValue;
+        EnergyMemory { fd_prev: self.fd_prev.extract(l), fte_prev: lane2(&self.fte_prev, l), ftd_prev: lane2(&self.ftd_prev, l), ut_prev: self.ut_prev.extract(l) }
+    }
+}
+
+/// What one step of one touching contact (or of four, in lanes) adds to the energy
+/// ledger, J: [`ContactModel::add_terms`] adds them, so that a ledger sums the same
+/// numbers in the same order whether the terms were computed alone or in lanes.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct EnergyTerms<R: Real = f64> {
+    /// Work of the normal damping force over the step (subtracted), J.
+    pub normal_damping: R,
+    /// Elastic energy in the normal spring now, J.
+    pub elastic_normal: R,
+    /// Work of the tangential damping force over the step (subtracted), J.
+    pub tangential_damping: R,
+    /// Energy lost to sliding, J.
+    pub friction: R,
+    /// Work of the tangential model (stiffness and frame changes), J.
+    pub tangential_model: R,
+    /// Elastic energy in the tangential spring now, J.
+    pub elastic_tangential: R,
+}
+
+impl EnergyTerms<crate::physics::lanes::Lanes> {
+    /// The terms of lane `l`.
+    #[inline(always)]
+    pub fn lane(&self, l: usize) -> EnergyTerms {
+        use simba::simd::SimdValue;
+        EnergyTerms {
+            normal_damping: self.normal_damping.extract(l),
+            elastic_normal: self.elastic_normal.extract(l),
+            tangential_damping: self.tangential_damping.extract(l),
+            friction: self.friction.extract(l),
+            tangential_model: self.tangential_model.extract(l),
+            elastic_tangential: self.elastic_tangential.extract(l),
+        }
+    }
+}
+
+/// A contact law: the trait the stages are generic over.
+pub trait ContactLaw: Copy + Send + Sync + 'static {
+    type Damp: Damping;
+    type Tang: Tangential;
+    fn options(&self) -> ModelOptions;
+    /// One line for `explain`.
+    fn describe(&self) -> String {
+        let o = self.options();
+        format!(
+            "Contacts<Hertz, {}, {}{}{}>",
+            Self::Damp::NAME,
+            Self::Tang::NAME,
+            if o.limit_force { ", clamp Fn>=0" } else { "" },
+            match (Self::Tang::FRICTION, o.lever_arm) {
+                (true, LeverArm::RadiusMinusHalfOverlap) => ", arm r-dn/2",
+                (true, LeverArm::Yade) => ", YADE ratcheting-free kinematics",
+                _ => "",
+            }
+        )
+    }
+}
+
+/// The Hertz-Mindlin contact model, composed from a damping form and a tangential
+/// formulation.
+#[derive(Clone, Copy, Debug)]
+pub struct ContactModel<Dm: Damping, T: Tangential> {
+    pub options: ModelOptions,
+    _p: PhantomData<(Dm, T)>,
+}
+
+impl<Dm: Damping, T: Tangential> ContactModel<Dm, T> {
+    pub fn new(options: ModelOptions) -> Self {
+        ContactModel { options, _p: PhantomData }
+    }
+
+    /// The force of a touching contact (of four, one per lane, with `R = Lanes`),
+    /// advancing its tangential state. No branch on the data: the same bits per lane as
+    /// for the contact alone.
+    #[inline(always)]
+    pub fn force<R: Real>(&self, c: &ContactInput<R>, pm: &PairMaterial<R>, h: &mut T::History<R>) -> ContactState<R> {
+        let st = HertzStiffness::new(pm.e_star, pm.g_star, c.r_star, c.dn);
+        let (gn, gt) = Dm::coefficients(pm, c.sqrt_m_star, st.root);
+        let vc = c.contact_velocity();
+        let vn = vc.dot(&c.n);
+        let elastic_n = st.kn * c.dn;
+        let mut fnorm = elastic_n - gn * vn;
+        if self.options.limit_force {
+            fnorm = pick(fnorm.simd_lt(R::zero()), R::zero(), fnorm);
+        }
+        let mut force = c.n * fnorm;
+        let mut tf = TangentialForce::default();
+        if T::FRICTION {
+            let mut vt = vc - c.n * vn;
+            if self.options.lever_arm == LeverArm::Yade {
+                vt += (c.v_rel - c.n * c.v_rel.dot(&c.n)) * (c.tangential_scale - R::one());
+            }
+            let inp = TangentialInput { n: c.n, vt, kt: st.kt, gt, cap: pm.friction * fnorm.simd_abs(), dt: c.dt };
+            tf = T::force(h, &inp);
+        }
+        force += tf.elastic + tf.damping;
+        ContactState { force, tangential: tf, normal: fnorm, elastic_normal: elastic_n, kn: st.kn, kt: st.kt, vc }
+    }
+
+    /// The force of a touching contact, updating its history; with `ENERGY`, the
+    /// trapezoidal work integrals of this step go into `ledger`.
+    #[inline(always)]
+    pub fn touch<const ENERGY: bool>(
+        &self,
+        c: &ContactInput,
+        pm: &PairMaterial,
+        h: &mut ContactHistory<T::History<f64>>,
+        ledger: &mut EnergyLedger,
+    ) -> ContactForce {
+        let s = self.force(c, pm, &mut h.tangential);
+        if ENERGY {
+            self.account(c.n, c.dn, c.dt, &s, &mut h.energy, ledger);
+        }
+        let tf = s.tangential;
+        ContactForce { force: s.force, tangential: tf.elastic + tf.damping, normal: s.normal, kn: s.kn }
+    }
+
+    /// The trapezoidal work integrals of one step of a touching contact (normal `n`,
+    /// overlap `dn`, m, time step `dt`, s), from what [`ContactModel::force`] computed,
+    /// into `ledger`; the previous-step values in `h` move on.
+    #[inline(always)]
+    pub fn account(&self, n: Vec2, dn: f64, dt: f64, s: &ContactState, h: &mut EnergyMemory, ledger: &mut EnergyLedger) {
+        let t = self.energy_terms(n, dn, dt, s, h);
+        self.add_terms(&t, ledger);
+    }
+
+    /// The energy terms of one step of a touching contact (of four, in lanes): see
+    /// [`ContactModel::account`]. No branch on the data: the same bits per lane as alone.
+    #[inline(always)]
+    pub fn energy_terms<R: Real>(&self, n: Vector2<R>, dn: R, dt: R, s: &ContactState<R>, h: &mut EnergyMemory<R>) -> EnergyTerms<R> {
+        let tf = s.tangential;
+        let dc = s.vc * dt;
+        let fd = s.normal - s.elastic_normal;
+        let mut t = EnergyTerms { normal_damping: k::<R>(0.5) * (h.fd_prev + fd) * dc.dot(&n), elastic_normal: hertz_energy(s.kn, dn), ..Default::default() };
+        if T::FRICTION {
+            let ut = pick(s.kt.simd_gt(R::zero()), k::<R>(0.5) * tf.elastic.norm_squared() / s.kt, R::zero());
+            t.tangential_damping = k::<R>(0.5) * (h.ftd_prev + tf.damping).dot(&dc);
+            let w_spring = k::<R>(0.5) * (h.fte_prev + tf.elastic).dot(&dc);
+            t.friction = tf.slip_energy;
+            t.tangential_model = ut - h.ut_prev + tf.slip_energy + w_spring;
+            t.elastic_tangential = ut;
+            h.fte_prev = tf.elastic;
+            h.ftd_prev = tf.damping;
+            h.ut_prev = ut;
+        }
+        h.fd_prev = fd;
+        t
+    }
+
+    /// Add one contact's energy terms to `ledger`.
+    #[inline(always)]
+    pub fn add_terms(&self, t: &EnergyTerms, ledger: &mut EnergyLedger) {
+        ledger.normal_damping -= t.normal_damping;
+        ledger.elastic_normal += t.elastic_normal;
+        if T::FRICTION {
+            ledger.tangential_damping -= t.tangential_damping;
+            ledger.friction += t.friction;
+            ledger.tangential_model += t.tangential_model;
+            ledger.elastic_tangential += t.elastic_tangential;
+        }
+    }
+
+    /// A contact that was touching at the previous step and is not any more: close its
+    /// energy integrals (the force fell to zero over this step) and forget its history:
+    /// the tangential state `t` and (with `ENERGY`) the energy memory `h`.
+    #[inline(always)]
+    pub fn release<const ENERGY: bool>(&self, c_velocity: Vec2, n: Vec2, dt: f64, t: &mut T::History<f64>, h: &mut EnergyMemory, ledger: &mut EnergyLedger) {
+        if ENERGY {
+            let dc = c_velocity * dt;
+            ledger.normal_damping -= 0.5 * h.fd_prev * dc.dot(&n);
+            if T::FRICTION {
+                ledger.tangential_damping -= 0.5 * h.ftd_prev.dot(&dc);
+                ledger.tangential_model += -h.ut_prev + 0.5 * h.fte_prev.dot(&dc);
+            }
+        }
+        *t = Default::default();
+        if ENERGY {
+            *h = EnergyMemory::default();
+        }
+    }
+}
+
+impl<Dm: Damping, T: Tangential> ContactLaw for ContactModel<Dm, T> {
+    type Damp = Dm;
+    type Tang = T;
+    fn options(&self) -> ModelOptions {
+        self.options
+    }
+}
+
+/// The named combinations grainlab compiles. A scene picks one of these; any other
+/// combination is refused with this list.
+pub type HertzFrictionless = ContactModel<Viscoelastic, Frictionless>;
+pub type HertzFrictionlessElastic = ContactModel<Undamped, Frictionless>;
+/// LIGGGHTS `pair_style gran model hertz tangential history`.
+pub type LiggghtsHertzHistory = ContactModel<Viscoelastic, TotalDisplacement>;
+pub type LiggghtsHertzHistoryElastic = ContactModel<Undamped, TotalDisplacement>;
+/// YADE `Law2_ScGeom_MindlinPhys_Mindlin` (incremental tangential force).
+pub type YadeMindlin = ContactModel<Viscoelastic, IncrementalForce>;
+pub type YadeMindlinElastic = ContactModel<Undamped, IncrementalForce>;

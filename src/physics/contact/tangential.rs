@@ -1,0 +1,165 @@
+//! Tangential contact force: none, LIGGGHTS' total displacement, or YADE's increments.
+//!
+//! Every formulation gets the relative velocity of the contact points `vt` (tangential
+//! part, m/s, of grain i relative to grain j), the tangential stiffness `kt` (N/m), the
+//! damping coefficient `gt` (kg/s), the Coulomb cap `mu |Fn|` (N) and the time step, and
+//! returns the elastic and the damping part of the tangential force on grain i.
+
+use nalgebra::Vector2;
+
+use crate::physics::dim::cross;
+use crate::physics::lanes::{Real, k, pick, pick2};
+
+/// What a tangential formulation needs of one contact (or one per lane) at one step.
+#[derive(Clone, Copy, Debug)]
+pub struct TangentialInput<R: Real = f64> {
+    /// Unit normal, from j to i.
+    pub n: Vector2<R>,
+    /// Tangential relative velocity of the contact points (i relative to j), m/s.
+    pub vt: Vector2<R>,
+    /// Tangential stiffness, N/m.
+    pub kt: R,
+    /// Tangential damping coefficient, kg/s.
+    pub gt: R,
+    /// Coulomb cap mu |Fn|, N.
+    pub cap: R,
+    /// Time step, s.
+    pub dt: R,
+}
+
+/// The tangential force on grain i, split for the energy balance.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct TangentialForce<R: Real = f64> {
+    /// Elastic (spring) part, N.
+    pub elastic: Vector2<R>,
+    /// Viscous part, N.
+    pub damping: Vector2<R>,
+    /// Elastic energy removed from the spring by sliding at this step, J.
+    pub slip_energy: R,
+}
+
+/// A tangential formulation, written once for one contact (`R = f64`) and for four
+/// contacts in lanes (`R = Lanes`), without branches on the data: sliding or sticking
+/// is a select.
+pub trait Tangential: Copy + Default + Send + Sync + 'static {
+    const NAME: &'static str;
+    /// False for frictionless contacts: no tangential force, no torque, no spin.
+    const FRICTION: bool;
+    /// The state a contact carries from step to step (one per lane with `R = Lanes`).
+    type History<R: Real>: Copy + Default + Send + Sync + std::fmt::Debug;
+    fn force<R: Real>(h: &mut Self::History<R>, inp: &TangentialInput<R>) -> TangentialForce<R>;
+    /// Four contacts' states in lanes.
+    fn gather(h: [&Self::History<f64>; crate::physics::lanes::LANES]) -> Self::History<crate::physics::lanes::Lanes>;
+    /// Lane `l` of a state in lanes.
+    fn lane(h: &Self::History<crate::physics::lanes::Lanes>, l: usize) -> Self::History<f64>;
+}
+
+/// No tangential force at all.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Frictionless;
+
+impl Tangential for Frictionless {
+    const NAME: &'static str = "Frictionless";
+    const FRICTION: bool = false;
+    type History<R: Real> = ();
+    #[inline(always)]
+    fn force<R: Real>(_: &mut (), _: &TangentialInput<R>) -> TangentialForce<R> {
+        TangentialForce::default()
+    }
+    #[inline(always)]
+    fn gather(_: [&(); crate::physics::lanes::LANES]) {}
+    #[inline(always)]
+    fn lane(_: &(), _: usize) {}
+}
+
+/// LIGGGHTS `tangential history`: a total tangential displacement `xi`, advanced by
+/// `vt dt` and projected onto the current tangent line each step; `Ft = -kt xi - gt vt`
+/// while sticking. When `|kt xi| > mu |Fn|` the contact slides: the force is the
+/// elastic force scaled down to the cap, `xi = -Ft/kt`, and there is no damping.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct TotalDisplacement;
+
+impl Tangential for TotalDisplacement {
+    const NAME: &'static str = "TotalDisplacementHistory";
+    const FRICTION: bool = true;
+    /// The tangential displacement xi, m.
+    type History<R: Real> = Vector2<R>;
+    #[inline(always)]
+    fn force<R: Real>(xi: &mut Vector2<R>, inp: &TangentialInput<R>) -> TangentialForce<R> {
+        let n = inp.n;
+        *xi += inp.vt * inp.dt;
+        let along_n = xi.dot(&n);
+        *xi -= n * along_n;
+        let elastic = *xi * -inp.kt;
+        let f_el = elastic.norm();
+        // cap >= 0, so a sliding contact has f_el > 0.
+        let slide = f_el.simd_gt(inp.cap);
+        let scale = pick(slide, inp.cap / f_el, R::one());
+        let scaled = elastic * scale;
+        let before = k::<R>(0.5) * inp.kt * xi.norm_squared();
+        // The displacement that gives the capped force: -scaled/kt = xi scale.
+        let xi_slid = *xi * scale;
+        let after = k::<R>(0.5) * inp.kt * xi_slid.norm_squared();
+        *xi = pick2(slide, xi_slid, *xi);
+        let damping = inp.vt * -inp.gt;
+        TangentialForce { elastic: scaled, damping: pick2(slide, Vector2::zeros(), damping), slip_energy: pick(slide, before - after, R::zero()) }
+    }
+    #[inline(always)]
+    fn gather(h: [&Vector2<f64>; crate::physics::lanes::LANES]) -> Vector2<crate::physics::lanes::Lanes> {
+        crate::physics::lanes::gather2(|l| *h[l])
+    }
+    #[inline(always)]
+    fn lane(h: &Vector2<crate::physics::lanes::Lanes>, l: usize) -> Vector2<f64> {
+        crate::physics::lanes::lane2(h, l)
+    }
+}
+
+/// State of a YADE-style incremental contact.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct IncrementalState<R: Real = f64> {
+    /// Elastic tangential force on grain i, N.
+    pub force: Vector2<R>,
+    /// The normal at the previous step (zero before the first step of a contact).
+    pub n_prev: Vector2<R>,
+}
+
+/// YADE `Law2_ScGeom_MindlinPhys_Mindlin`: the elastic tangential force is rotated with
+/// the contact frame (to first order, as YADE's `ScGeom::rotate`) and incremented by
+/// `-kt vt dt` with `kt` at the current overlap; Coulomb caps the elastic part; the
+/// viscous part `-gt vt` is added on top while sticking.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct IncrementalForce;
+
+impl Tangential for IncrementalForce {
+    const NAME: &'static str = "IncrementalForce";
+    const FRICTION: bool = true;
+    type History<R: Real> = IncrementalState<R>;
+    #[inline(always)]
+    fn force<R: Real>(h: &mut IncrementalState<R>, inp: &TangentialInput<R>) -> TangentialForce<R> {
+        let n = inp.n;
+        // Rotate with the normal: in the plane the axis n_prev x n is along z and the
+        // first-order rotation adds (axis x F).
+        let s = cross(h.n_prev, n);
+        let f = h.force;
+        let rotated = f + Vector2::new(-f.y, f.x) * s;
+        h.n_prev = n;
+        let trial = rotated - inp.vt * inp.kt * inp.dt;
+        let f_el = trial.norm();
+        // cap >= 0, so a sliding contact has f_el > 0 (and kt > 0: the trial force grew).
+        let slide = f_el.simd_gt(inp.cap);
+        let scaled = trial * (inp.cap / f_el);
+        let slip_energy = k::<R>(0.5) * (trial.norm_squared() - scaled.norm_squared()) / inp.kt;
+        let elastic = pick2(slide, scaled, trial);
+        h.force = elastic;
+        let damping = inp.vt * -inp.gt;
+        TangentialForce { elastic, damping: pick2(slide, Vector2::zeros(), damping), slip_energy: pick(slide, slip_energy, R::zero()) }
+    }
+    #[inline(always)]
+    fn gather(h: [&IncrementalState<f64>; crate::physics::lanes::LANES]) -> IncrementalState<crate::physics::lanes::Lanes> {
+        IncrementalState { force: crate::physics::lanes::gather2(|l| h[l].force), n_prev: crate::physics::lanes::gather2(|l| h[l].n_prev) }
+    }
+    #[inline(always)]
+    fn lane(h: &IncrementalState<crate::physics::lanes::Lanes>, l: usize) -> IncrementalState<f64> {
+        IncrementalState { force: crate::physics::lanes::lane2(&h.force, l), n_prev: crate::physics::lanes::lane2(&h.n_prev, l) }
+    }
+}

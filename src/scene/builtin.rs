@@ -1,0 +1,180 @@
+//! Built-in scenes, runnable by name: `grainlab run shear`. `grainlab scenes NAME` prints
+//! one as JSON to start a scene file from.
+
+use crate::physics::contact::LeverArm;
+use crate::physics::material::Material;
+use crate::scene::*;
+use crate::scene::pack::RadiusDist;
+
+/// Names and one-line descriptions.
+pub const BUILTIN: &[(&str, &str)] = &[
+    ("collision", "two glass beads head-on at 1 m/s, e = 0.5: the seed's 1D model with energy monitoring"),
+    ("oblique", "a glass bead hitting a flat glass wall at 45 degrees and 1 m/s, e = 0.9, mu = 0.5"),
+    ("shear", "the seed's experiment: ~1000 polydisperse glass beads, periodic x, rough walls at +-0.5 m/s under 100 kPa"),
+];
+
+fn glass(restitution: f64) -> Material {
+    Material { restitution, ..Material::default() }
+}
+
+/// Two equal grains of radius `r` approaching head-on at relative speed `v`.
+///
+/// They start 10.5 time steps before contact, so that the contact begins half-way
+/// through a step at every speed and time step: the realised restitution depends on
+/// that phase at O(dt/t_c), and fixing it makes results depend on dt/t_c alone.
+pub fn head_on(material: Material, r: f64, v: f64, steps_per_contact: f64) -> Scene {
+    let m = 4.0 / 3.0 * std::f64::consts::PI * r * r * r * material.density;
+    let e_star = crate::physics::material::PairMaterial::mix(&material, &material).e_star;
+    let dt = crate::physics::material::hertz_contact_time(m / 2.0, r / 2.0, e_star, v) / steps_per_contact;
+    let gap = 10.5 * v * dt;
+    Scene {
+        name: "collision".into(),
+        description: BUILTIN[0].1.into(),
+        grain_shape: Default::default(),
+        materials: vec![material],
+        domain: Domain::default(),
+        grains: Grains::List(vec![
+            GrainSpec { x: [-r - gap / 2.0, 0.0], v: [v / 2.0, 0.0], omega: 0.0, r, material: 0 },
+            GrainSpec { x: [r + gap / 2.0, 0.0], v: [-v / 2.0, 0.0], omega: 0.0, r, material: 0 },
+        ]),
+        walls: None,
+        gravity: [0.0, 0.0],
+        model: ModelSpec::default(),
+        time_step: TimeStepSpec {
+            rule: TimeStepRule::StepsPerContact { steps: steps_per_contact, impact_speed: v },
+            characteristic_speed: None,
+            allow_unstable: false,
+        },
+        // The approach and three contact times (the run stops at separation anyway).
+        duration: 2.0 * gap / v + 3.0 * crate::physics::material::hertz_contact_time(m / 2.0, r / 2.0, e_star, v),
+        neighbor: NeighborSpec::default(),
+        output: OutputSpec { samples: 200, frames: 0, energy: true },
+        analysis: Analysis::Impact,
+    }
+}
+
+/// A grain of radius `r` hitting a flat wall at `angle_deg` from the normal at speed `v`.
+pub fn oblique(material: Material, r: f64, v: f64, angle_deg: f64, tangential: TangentialSpec, steps_per_contact: f64) -> Scene {
+    let a = angle_deg.to_radians();
+    let mut s = head_on(material.clone(), r, v, steps_per_contact);
+    // 10.5 steps before contact, as for head-on impacts (grain on wall: m* = m, R* = r).
+    let m = 4.0 / 3.0 * std::f64::consts::PI * r * r * r * material.density;
+    let e_star = crate::physics::material::PairMaterial::mix(&material, &material).e_star;
+    let dt = crate::physics::material::hertz_contact_time(m, r, e_star, v).min(crate::physics::material::hertz_contact_time(m / 2.0, r / 2.0, e_star, v)) / steps_per_contact;
+    let gap = 10.5 * v * a.cos() * dt;
+    s.name = "oblique".into();
+    s.description = BUILTIN[1].1.into();
+    s.grains = Grains::List(vec![GrainSpec { x: [0.0, r + gap], v: [v * a.sin(), -v * a.cos()], omega: 0.0, r, material: 0 }]);
+    s.walls = Some(WallsSpec {
+        bottom: WallSpec { y: Some(0.0), velocity_x: 0.0, surface: SurfaceSpec::Flat, control: ControlSpec::Fixed, mass: None, material: 0 },
+        top: WallSpec { y: Some(1.0), velocity_x: 0.0, surface: SurfaceSpec::Flat, control: ControlSpec::Fixed, mass: None, material: 0 },
+        thickness: None,
+    });
+    s.model.tangential = tangential;
+    s
+}
+
+/// A grain of radius `r` hitting a resting twin at speed `v`, `angle_deg` between its
+/// velocity and the line of centres at contact. It starts 10.5 steps before contact.
+pub fn oblique_pair(material: Material, r: f64, v: f64, angle_deg: f64, tangential: TangentialSpec, steps_per_contact: f64) -> Scene {
+    let a = angle_deg.to_radians();
+    let mut s = head_on(material.clone(), r, v, steps_per_contact);
+    let m = 4.0 / 3.0 * std::f64::consts::PI * r * r * r * material.density;
+    let e_star = crate::physics::material::PairMaterial::mix(&material, &material).e_star;
+    let dt = crate::physics::material::hertz_contact_time(m / 2.0, r / 2.0, e_star, v) / steps_per_contact;
+    // Moving down (-y) onto a grain at the origin: at contact n = (sin a, cos a).
+    let gap = 10.5 * v * dt;
+    s.name = "oblique-pair".into();
+    s.description = format!("a glass bead hitting a resting one at {angle_deg} degrees and {v} m/s");
+    s.grains = Grains::List(vec![
+        GrainSpec { x: [2.0 * r * a.sin(), 2.0 * r * a.cos() + gap], v: [0.0, -v], omega: 0.0, r, material: 0 },
+        GrainSpec { x: [0.0, 0.0], v: [0.0, 0.0], omega: 0.0, r, material: 0 },
+    ]);
+    s.model.tangential = tangential;
+    s
+}
+
+/// The seed's shear cell.
+pub fn shear() -> Scene {
+    let (l, v, p) = (0.04, 0.5, 1e5);
+    Scene {
+        name: "shear".into(),
+        description: BUILTIN[2].1.into(),
+        grain_shape: Default::default(),
+        materials: vec![glass(0.5)],
+        domain: Domain { periodic_x: Some([0.0, l]) },
+        grains: Grains::Pack(PackSpec {
+            count: 1000,
+            radius: RadiusDist::Uniform { min: 0.4e-3, max: 0.6e-3 },
+            seed: 1,
+            material: 0,
+            x: [0.0, l],
+            y_min: None,
+            packing_fraction: 0.75,
+        }),
+        walls: Some(WallsSpec {
+            bottom: WallSpec { y: Some(0.0), velocity_x: -v, surface: SurfaceSpec::Rough { radius: 0.5e-3 }, control: ControlSpec::Fixed, mass: None, material: 0 },
+            top: WallSpec { y: None, velocity_x: v, surface: SurfaceSpec::Rough { radius: 0.5e-3 }, control: ControlSpec::Pressure(p), mass: None, material: 0 },
+            thickness: None,
+        }),
+        gravity: [0.0, 0.0],
+        model: ModelSpec { lever_arm: LeverArm::Radius, ..ModelSpec::default() },
+        time_step: TimeStepSpec { rule: TimeStepRule::StepsPerContact { steps: 50.0, impact_speed: v }, characteristic_speed: None, allow_unstable: false },
+        duration: 0.05,
+        neighbor: NeighborSpec::default(),
+        output: OutputSpec { samples: 400, frames: 20, energy: true },
+        analysis: Analysis::Shear,
+    }
+}
+
+/// The seed's shear cell with `count` grains over a periodic length `length`, m: the
+/// same height when `count` grows with `length` (1000 grains per 0.04 m), as the tests
+/// and `scripts/bench-peers` size it.
+pub fn shear_cell(count: usize, length: f64) -> Scene {
+    let mut s = shear();
+    if let Grains::Pack(p) = &mut s.grains {
+        p.count = count;
+        p.x = [0.0, length];
+    }
+    s.domain.periodic_x = Some([0.0, length]);
+    s
+}
+
+/// A scene named on the command line: a built-in name, or a scene file (read up to the
+/// budget's file size, [`crate::scene::limits::Limits::file_bytes`]). A built-in name wins over
+/// a folder of that name in the working directory; a file of that name is ambiguous and
+/// refused (write `./NAME` for the file). A grain file's relative path is taken from the
+/// scene file's folder.
+pub fn load(arg: &str, limits: &crate::scene::limits::Limits) -> Result<Scene, crate::Error> {
+    let path = std::path::Path::new(arg);
+    if let Some(scene) = builtin(arg) {
+        if path.is_file() {
+            return Err(crate::Error::Scene(format!("`{arg}` is both a built-in scene and a file in this folder: write `./{arg}` for the file")));
+        }
+        return Ok(scene);
+    }
+    if !path.exists() {
+        let names: Vec<&str> = BUILTIN.iter().map(|b| b.0).collect();
+        return Err(crate::Error::Scene(format!("`{arg}` is neither a scene file nor a built-in scene ({})", names.join(", "))));
+    }
+    let text = crate::scene::limits::read_bounded(path, limits.file_bytes(), "scene file")?;
+    let mut scene = Scene::from_json(&text)?;
+    if let Grains::File { path: grains, .. } = &mut scene.grains {
+        let p = std::path::Path::new(grains.as_str());
+        if p.is_relative() {
+            let folder = path.parent().unwrap_or(std::path::Path::new(""));
+            *grains = folder.join(p).to_string_lossy().into_owned();
+        }
+    }
+    Ok(scene)
+}
+
+/// A built-in scene by name.
+pub fn builtin(name: &str) -> Option<Scene> {
+    match name {
+        "collision" => Some(head_on(glass(0.5), 1e-3, 1.0, 200.0)),
+        "oblique" => Some(oblique(glass(0.9), 1e-3, 1.0, 45.0, TangentialSpec::TotalDisplacement, 200.0)),
+        "shear" => Some(shear()),
+        _ => None,
+    }
+}

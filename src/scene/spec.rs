@@ -1,0 +1,383 @@
+//! The scene file (JSON): what is simulated, how, and what is written.
+//!
+//! Every field, its unit and its default are listed in docs/scene.md. A scene is
+//! validated as a whole before anything is built or written
+//! ([`crate::scene::validate`]); an error names the field, the value and the allowed
+//! range.
+
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+
+use crate::physics::contact::LeverArm;
+use crate::physics::dim::GrainShape;
+use crate::physics::material::Material;
+use crate::scene::pack::RadiusDist;
+
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct Scene {
+    /// Name, used for output files.
+    pub name: String,
+    #[serde(default)]
+    pub description: String,
+    /// Sphere-in-plane (default) or disk of a stated thickness.
+    #[serde(default)]
+    pub grain_shape: GrainShape,
+    /// Materials; grains and walls refer to them by index. Default: one glass.
+    #[serde(default = "default_materials")]
+    pub materials: Vec<Material>,
+    /// Periodicity in x. Default: none.
+    #[serde(default)]
+    pub domain: Domain,
+    pub grains: Grains,
+    /// Bottom and top walls. Default: none.
+    #[serde(default)]
+    pub walls: Option<WallsSpec>,
+    /// Gravity, m/s^2. Default [0, 0] (off: no stage).
+    #[serde(default)]
+    pub gravity: [f64; 2],
+    #[serde(default)]
+    pub model: ModelSpec,
+    pub time_step: TimeStepSpec,
+    /// Simulated time, s.
+    pub duration: f64,
+    #[serde(default)]
+    pub neighbor: NeighborSpec,
+    #[serde(default)]
+    pub output: OutputSpec,
+    /// What the summary reports. Default: none.
+    #[serde(default)]
+    pub analysis: Analysis,
+}
+
+fn default_materials() -> Vec<Material> {
+    vec![Material::default()]
+}
+
+#[derive(Clone, Debug, Default, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct Domain {
+    /// `[x_min, x_max]` of the periodic cell, m. Default: not periodic.
+    #[serde(default)]
+    pub periodic_x: Option<[f64; 2]>,
+}
+
+/// Where the grains come from.
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum Grains {
+    /// Grains listed one by one.
+    List(Vec<GrainSpec>),
+    /// A particle file: one grain per line, in the declared `columns` (m); `#` starts a
+    /// comment. A relative path is taken from the scene file's folder.
+    File {
+        path: String,
+        /// The numbers on each line. Default `"x y r"`.
+        #[serde(default)]
+        columns: GrainColumns,
+        #[serde(default)]
+        material: usize,
+    },
+    /// A seeded random packing.
+    Pack(PackSpec),
+}
+
+/// The columns of a grain file.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+pub enum GrainColumns {
+    /// Centre x, y and radius, m.
+    #[default]
+    #[serde(rename = "x y r")]
+    XYR,
+    /// Centre x, y, z and radius, m; z is read and ignored (a LAMMPS-style 3D file of a
+    /// monolayer).
+    #[serde(rename = "x y z r")]
+    XYZR,
+}
+
+impl GrainColumns {
+    /// Numbers per line.
+    pub fn count(self) -> usize {
+        match self {
+            GrainColumns::XYR => 3,
+            GrainColumns::XYZR => 4,
+        }
+    }
+    pub fn name(self) -> &'static str {
+        match self {
+            GrainColumns::XYR => "x y r",
+            GrainColumns::XYZR => "x y z r",
+        }
+    }
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct GrainSpec {
+    /// Centre, m.
+    pub x: [f64; 2],
+    /// Velocity, m/s. Default [0, 0].
+    #[serde(default)]
+    pub v: [f64; 2],
+    /// Spin about z, rad/s. Default 0.
+    #[serde(default)]
+    pub omega: f64,
+    /// Radius, m.
+    pub r: f64,
+    /// Material index. Default 0.
+    #[serde(default)]
+    pub material: usize,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct PackSpec {
+    /// Number of grains.
+    pub count: usize,
+    pub radius: RadiusDist,
+    /// Seed of the ChaCha8 stream for radii and positions. Default 1.
+    #[serde(default = "one")]
+    pub seed: u64,
+    /// Material index. Default 0.
+    #[serde(default)]
+    pub material: usize,
+    /// `[x_min, x_max]` of the packing region, m (the periodic cell if periodic).
+    pub x: [f64; 2],
+    /// Lower edge of the packing region, m. Default: on the bottom wall.
+    #[serde(default)]
+    pub y_min: Option<f64>,
+    /// Area fraction the region is sized for (its height follows), in (0, 0.8].
+    /// Default 0.75 (denser random packings do not relax free of overlaps).
+    #[serde(default = "default_fraction")]
+    pub packing_fraction: f64,
+}
+
+fn one() -> u64 {
+    1
+}
+fn default_fraction() -> f64 {
+    0.75
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct WallsSpec {
+    pub bottom: WallSpec,
+    pub top: WallSpec,
+    /// Out-of-plane depth that turns wall forces into stresses, m: stress = F / (L_x t).
+    /// Default: the disk thickness, or the mean grain diameter for spheres in the plane.
+    #[serde(default)]
+    pub thickness: Option<f64>,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct WallSpec {
+    /// Position of the contact plane (flat) or of the glued grains' centres (rough), m.
+    /// Default for the top wall: just above the packing.
+    #[serde(default)]
+    pub y: Option<f64>,
+    /// Velocity in x, m/s. Default 0.
+    #[serde(default)]
+    pub velocity_x: f64,
+    /// `"flat"` (default) or `{"rough": {"radius": r}}`.
+    #[serde(default)]
+    pub surface: SurfaceSpec,
+    /// `"fixed"` (default) or `{"pressure": p}` (Pa, on the top wall).
+    #[serde(default)]
+    pub control: ControlSpec,
+    /// Mass that a pressure accelerates, kg. Default: the glued grains, or a row of
+    /// grains of mean size for a flat wall.
+    #[serde(default)]
+    pub mass: Option<f64>,
+    /// Material index. Default 0.
+    #[serde(default)]
+    pub material: usize,
+}
+
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum SurfaceSpec {
+    #[default]
+    Flat,
+    /// A row of touching grains of this radius (m) glued to the wall.
+    Rough { radius: f64 },
+}
+
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum ControlSpec {
+    #[default]
+    Fixed,
+    /// Constant normal stress on the wall, Pa.
+    Pressure(f64),
+}
+
+/// Tangential formulation.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum TangentialSpec {
+    /// LIGGGHTS `tangential history`.
+    #[default]
+    TotalDisplacement,
+    /// YADE `Law2_ScGeom_MindlinPhys_Mindlin`.
+    IncrementalForce,
+    /// No tangential force (and no spin).
+    Frictionless,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ModelSpec {
+    #[serde(default)]
+    pub tangential: TangentialSpec,
+    /// Clamp Fn >= 0 (LIGGGHTS `limitForce`). Default false.
+    #[serde(default)]
+    pub limit_force: bool,
+    /// Torque lever arm: `"radius"` (default, the seed) or `"radius_minus_half_overlap"`.
+    #[serde(default)]
+    pub lever_arm: LeverArm,
+    /// Integrate spins. Default true (ignored without friction).
+    #[serde(default = "yes")]
+    pub rotation: bool,
+    /// The seed's general damping: a viscous drag on every free grain, `F = -c m v`,
+    /// `M = -c I w`, with the rate `c` in 1/s (> 0). Its dissipation enters the energy
+    /// balance. Default none (no stage).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub general_damping: Option<f64>,
+}
+
+fn yes() -> bool {
+    true
+}
+
+impl Default for ModelSpec {
+    fn default() -> Self {
+        ModelSpec { tangential: TangentialSpec::default(), limit_force: false, lever_arm: LeverArm::default(), rotation: true, general_damping: None }
+    }
+}
+
+/// How the time step is chosen.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum TimeStepRule {
+    /// A given dt, s.
+    Fixed { dt: f64 },
+    /// dt = t_c / steps, t_c the Hertz contact time of the smallest grains at `impact_speed` (m/s).
+    StepsPerContact { steps: f64, impact_speed: f64 },
+    /// dt = fraction x the Rayleigh time of the smallest grain.
+    RayleighFraction { fraction: f64 },
+    /// The seed's rule dt = factor x 2 sqrt(min m / max k), k = kn at an overlap of
+    /// `reference_overlap` x the smallest radius.
+    SeedRule { factor: f64, reference_overlap: f64 },
+    /// The largest dt whose measured error on `quantity` is within `tolerance`, from the
+    /// convergence of a head-on impact of the smallest grains at `impact_speed` (m/s);
+    /// see [`crate::study::accuracy`].
+    Accuracy { quantity: AccuracyQuantity, tolerance: f64, impact_speed: f64 },
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct TimeStepSpec {
+    pub rule: TimeStepRule,
+    /// Speed that sets the overlap for the stability limit and for reporting steps per
+    /// contact, m/s. Default: the rule's impact speed, else 1.
+    #[serde(default)]
+    pub characteristic_speed: Option<f64>,
+    /// Run even when dt exceeds the stability limit. Default false.
+    #[serde(default)]
+    pub allow_unstable: bool,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct NeighborSpec {
+    /// Verlet skin as a fraction of the smallest grain diameter, > 0. Default 0.2.
+    #[serde(default = "default_skin")]
+    pub skin: f64,
+}
+
+fn default_skin() -> f64 {
+    0.2
+}
+
+impl Default for NeighborSpec {
+    fn default() -> Self {
+        NeighborSpec { skin: default_skin() }
+    }
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct OutputSpec {
+    /// Rows of the time series (energy, walls). Default 200.
+    #[serde(default = "default_samples")]
+    pub samples: u64,
+    /// ParaView frames (0: none). Default 20.
+    #[serde(default = "default_frames")]
+    pub frames: u64,
+    /// Track the energy balance. Default true.
+    #[serde(default = "yes")]
+    pub energy: bool,
+}
+
+fn default_samples() -> u64 {
+    200
+}
+fn default_frames() -> u64 {
+    20
+}
+
+impl Default for OutputSpec {
+    fn default() -> Self {
+        OutputSpec { samples: default_samples(), frames: default_frames(), energy: true }
+    }
+}
+
+/// What the summary reports.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum Analysis {
+    #[default]
+    None,
+    /// Grain 0 against grain 1, or grain 0 against a wall: restitution, overlap, force.
+    Impact,
+    /// Wall stresses with confidence intervals over the second half of the run.
+    Shear,
+}
+
+impl SurfaceSpec {
+    /// The glued grains' radius of a rough wall (its surface lies that far from its `y`),
+    /// 0 for a flat wall, m.
+    pub fn radius(&self) -> f64 {
+        match *self {
+            SurfaceSpec::Flat => 0.0,
+            SurfaceSpec::Rough { radius } => radius,
+        }
+    }
+}
+
+/// The measured quantity a tolerance applies to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum AccuracyQuantity {
+    /// Realised normal restitution, absolute error.
+    Restitution,
+    /// Peak normal force, relative error.
+    PeakForce,
+    /// Largest overlap, relative error.
+    MaxOverlap,
+    /// Contact duration, relative error.
+    ContactTime,
+}
+
+impl AccuracyQuantity {
+    pub fn name(self) -> &'static str {
+        match self {
+            AccuracyQuantity::Restitution => "restitution error (abs)",
+            AccuracyQuantity::PeakForce => "peak force error (rel)",
+            AccuracyQuantity::MaxOverlap => "max overlap error (rel)",
+            AccuracyQuantity::ContactTime => "contact time error (rel)",
+        }
+    }
+}

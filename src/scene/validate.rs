@@ -1,0 +1,172 @@
+//! Reading a scene and validating it as a whole: a parse error names the JSON path of
+//! the field it is in, a refusal names the field, its value and what is allowed. Nothing
+//! is built or written before a scene has passed.
+
+use crate::error::{Error, check};
+use crate::physics::dim::GrainShape;
+use crate::scene::limits::{MAX_FRAMES, MAX_MATERIALS};
+use crate::scene::spec::*;
+
+fn finite_pos(v: f64) -> bool {
+    v.is_finite() && v > 0.0
+}
+
+impl Scene {
+    /// Parse and validate a scene. A parse error names the JSON path of the field it is
+    /// in (`grains.list[1].r: invalid type: string "a", expected f64 at line 9 column 14`).
+    pub fn from_json(text: &str) -> Result<Scene, Error> {
+        let mut de = serde_json::Deserializer::from_str(text);
+        let s: Scene = serde_path_to_error::deserialize(&mut de).map_err(|e| {
+            let path = e.path().to_string();
+            let inner = e.into_inner();
+            let mut what = inner.to_string();
+            // serde_json reports an array with more elements than a fixed-size field takes
+            // (`"gravity": [0, -9.81, 0]`) as trailing characters: say what it is.
+            if what.starts_with("trailing characters") && path != "." {
+                what = what.replacen("trailing characters", "more elements than the field takes", 1);
+            }
+            Error::Parse { path, what }
+        })?;
+        de.end().map_err(|e| Error::Parse { path: ".".into(), what: format!("{e} (after the scene object)") })?;
+        s.validate()?;
+        Ok(s)
+    }
+
+    pub fn to_json(&self) -> String {
+        serde_json::to_string_pretty(self).expect("a scene always serialises")
+    }
+
+    /// Check every field on its own and against the others, before anything is built;
+    /// the first error names the field (its JSON path), the value and what is allowed.
+    /// What depends on the grains themselves (a file's grains, a packing's radii, the
+    /// time step) is checked by the build once it has them, still before the engine is
+    /// allocated ([`crate::engine::build`]).
+    pub fn validate(&self) -> Result<(), Error> {
+        let nmat = self.materials.len();
+        check((1..=MAX_MATERIALS).contains(&nmat), "", "materials", format!("{nmat} materials"), &format!("1 to {MAX_MATERIALS} materials"))?;
+        for (k, m) in self.materials.iter().enumerate() {
+            m.validate(&format!("materials[{k}]"))?;
+        }
+        let mat_ok = |k: usize| k < nmat;
+        let mats = format!("0..{}", nmat - 1);
+        if let GrainShape::Disk { thickness } = self.grain_shape {
+            check(finite_pos(thickness), "grain_shape.disk", "thickness", thickness, "> 0 m")?;
+        }
+        if let Some([a, b]) = self.domain.periodic_x {
+            check(a.is_finite() && b.is_finite() && finite_pos(b - a), "domain", "periodic_x", format!("[{a}, {b}]"), "finite x_min < x_max")?;
+        }
+        match &self.grains {
+            Grains::List(list) => {
+                check(!list.is_empty(), "grains", "list", "[]", "at least one grain")?;
+                for (k, g) in list.iter().enumerate() {
+                    let at = format!("grains.list[{k}]");
+                    check(finite_pos(g.r), &at, "r", g.r, "> 0 m")?;
+                    check(g.x.iter().all(|v| v.is_finite()), &at, "x", format!("{:?}", g.x), "finite m")?;
+                    check(g.v.iter().all(|v| v.is_finite()), &at, "v", format!("{:?}", g.v), "finite m/s")?;
+                    check(g.omega.is_finite(), &at, "omega", g.omega, "finite rad/s")?;
+                    check(mat_ok(g.material), &at, "material", g.material, &mats)?;
+                }
+            }
+            Grains::File { path, material, .. } => {
+                check(!path.is_empty(), "grains.file", "path", "\"\"", "a file name")?;
+                check(mat_ok(*material), "grains.file", "material", material, &mats)?;
+            }
+            Grains::Pack(p) => {
+                check(p.count >= 1, "grains.pack", "count", p.count, ">= 1")?;
+                p.radius.validate("grains.pack.radius")?;
+                check(mat_ok(p.material), "grains.pack", "material", p.material, &mats)?;
+                check(p.x.iter().all(|v| v.is_finite()) && finite_pos(p.x[1] - p.x[0]), "grains.pack", "x", format!("{:?}", p.x), "finite x_min < x_max")?;
+                if let Some(y) = p.y_min {
+                    check(y.is_finite(), "grains.pack", "y_min", y, "finite m")?;
+                }
+                check(p.packing_fraction > 0.0 && p.packing_fraction <= 0.8, "grains.pack", "packing_fraction", p.packing_fraction, "(0, 0.8]")?;
+                check(p.y_min.is_some() || self.walls.is_some(), "grains.pack", "y_min", "none", "a value, or walls to stand on")?;
+                if let Some([a, b]) = self.domain.periodic_x {
+                    // The packing is periodic over the cell when its region is the cell;
+                    // a region inside the cell is packed with walls at its ends; one that
+                    // reaches out of it would overlap its own image.
+                    check(p.x[0] >= a && p.x[1] <= b, "grains.pack", "x", format!("{:?}", p.x), &format!("inside the periodic cell [{a}, {b}] m"))?;
+                }
+            }
+        }
+        if let Some(w) = &self.walls {
+            for (name, s) in [("bottom", &w.bottom), ("top", &w.top)] {
+                let at = format!("walls.{name}");
+                if let Some(y) = s.y {
+                    check(y.is_finite(), &at, "y", y, "finite m")?;
+                }
+                check(s.velocity_x.is_finite(), &at, "velocity_x", s.velocity_x, "finite m/s")?;
+                check(mat_ok(s.material), &at, "material", s.material, &mats)?;
+                if let SurfaceSpec::Rough { radius } = s.surface {
+                    check(finite_pos(radius), &format!("{at}.surface.rough"), "radius", radius, "> 0 m")?;
+                    if let Some([a, b]) = self.domain.periodic_x {
+                        check(2.0 * radius <= b - a, &format!("{at}.surface.rough"), "radius", radius, &format!("<= {} m, half the periodic cell's length (one glued grain must fit in it)", 0.5 * (b - a)))?;
+                    }
+                }
+                if let ControlSpec::Pressure(p) = s.control {
+                    check(name == "top", &at, "control", "pressure", "fixed (only the top wall carries a load)")?;
+                    check(finite_pos(p), &at, "control.pressure", p, "> 0 Pa")?;
+                }
+                if let Some(m) = s.mass {
+                    check(finite_pos(m), &at, "mass", m, "> 0 kg")?;
+                }
+            }
+            let bottom_y = w.bottom.y;
+            check(bottom_y.is_some(), "walls.bottom", "y", "none", "a position in m")?;
+            if let (Some(b), Some(t)) = (bottom_y, w.top.y) {
+                // The contact surfaces: the plane of a flat wall, the far side of a rough
+                // wall's glued grains.
+                let (bs, ts) = (b + w.bottom.surface.radius(), t - w.top.surface.radius());
+                check(ts > bs, "walls.top", "y", t, &format!("a top wall above the bottom wall: its surface (now {ts} m) above the bottom wall's (at {bs} m)"))?;
+            }
+            if let (Grains::Pack(_), Some(y0), Some(b)) = (&self.grains, self.grains_floor(), bottom_y) {
+                let bs = b + w.bottom.surface.radius();
+                check(y0 >= bs, "grains.pack", "y_min", y0, &format!(">= {bs} m, the bottom wall's surface (or omit it to stand on the wall)"))?;
+            }
+            if let Some(t) = w.thickness {
+                check(finite_pos(t), "walls", "thickness", t, "> 0 m")?;
+            }
+        }
+        check(self.gravity.iter().all(|g| g.is_finite()), "", "gravity", format!("{:?}", self.gravity), "finite m/s^2")?;
+        match self.time_step.rule {
+            TimeStepRule::Fixed { dt } => check(finite_pos(dt), "time_step.rule.fixed", "dt", dt, "> 0 s")?,
+            TimeStepRule::StepsPerContact { steps, impact_speed } => {
+                check(steps.is_finite() && steps >= 1.0, "time_step.rule.steps_per_contact", "steps", steps, ">= 1")?;
+                check(finite_pos(impact_speed), "time_step.rule.steps_per_contact", "impact_speed", impact_speed, "> 0 m/s")?;
+            }
+            TimeStepRule::RayleighFraction { fraction } => {
+                check(fraction > 0.0 && fraction <= 1.0, "time_step.rule.rayleigh_fraction", "fraction", fraction, "(0, 1]")?
+            }
+            TimeStepRule::SeedRule { factor, reference_overlap } => {
+                check(factor > 0.0 && factor <= 1.0, "time_step.rule.seed_rule", "factor", factor, "(0, 1]")?;
+                check(reference_overlap > 0.0 && reference_overlap < 1.0, "time_step.rule.seed_rule", "reference_overlap", reference_overlap, "(0, 1) of the smallest radius")?;
+            }
+            TimeStepRule::Accuracy { tolerance, impact_speed, .. } => {
+                check(tolerance.is_finite() && tolerance > 0.0, "time_step.rule.accuracy", "tolerance", tolerance, "> 0")?;
+                check(finite_pos(impact_speed), "time_step.rule.accuracy", "impact_speed", impact_speed, "> 0 m/s")?;
+            }
+        }
+        if let Some(c) = self.model.general_damping {
+            check(finite_pos(c), "model", "general_damping", c, "> 0 1/s (omit it for none)")?;
+        }
+        if let Some(v) = self.time_step.characteristic_speed {
+            check(finite_pos(v), "time_step", "characteristic_speed", v, "> 0 m/s")?;
+        }
+        check(finite_pos(self.duration), "", "duration", self.duration, "> 0 s")?;
+        check(finite_pos(self.neighbor.skin) && self.neighbor.skin <= 2.0, "neighbor", "skin", self.neighbor.skin, "(0, 2] smallest diameters")?;
+        check(self.output.samples >= 1, "output", "samples", self.output.samples, ">= 1")?;
+        check(self.output.frames <= MAX_FRAMES, "output", "frames", self.output.frames, &format!("0 to {MAX_FRAMES} (each frame rewrites the .pvd index and the manifest)"))?;
+        if self.analysis == Analysis::Shear {
+            check(self.walls.is_some() && self.domain.periodic_x.is_some(), "", "analysis", "shear", "a scene with walls and periodic_x")?;
+        }
+        Ok(())
+    }
+
+    /// The lower edge of a packing's region: its `y_min`, else the bottom wall's surface.
+    pub fn grains_floor(&self) -> Option<f64> {
+        match &self.grains {
+            Grains::Pack(p) => p.y_min.or_else(|| self.walls.as_ref().and_then(|w| w.bottom.y.map(|y| y + w.bottom.surface.radius()))),
+            _ => None,
+        }
+    }
+}

@@ -1,0 +1,175 @@
+//! The cases: the restitution grid, the oblique impacts and the shear cells grainlab is
+//! checked on, each a scene and the codes that compute the same model, written under
+//! `reference/cases/<case>/` with each code's deck.
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::Error;
+use crate::physics::contact::LeverArm;
+use crate::physics::material::Material;
+use crate::scene::{Scene, TangentialSpec, builtin};
+use crate::workbench::export::{Code, ExportInfo, export};
+
+/// The restitution grid.
+pub const GRID_E: [f64; 6] = [0.1, 0.3, 0.5, 0.7, 0.9, 0.99];
+pub const GRID_V: [f64; 4] = [0.01, 0.1, 1.0, 10.0];
+pub const GRID_STEPS: [f64; 2] = [50.0, 500.0];
+/// Oblique impact angles from the normal, degrees.
+pub const ANGLES: [f64; 7] = [5.0, 15.0, 30.0, 45.0, 60.0, 75.0, 85.0];
+
+/// What a case is for, stored as `case.json` beside its scene.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct CaseInfo {
+    /// Folder under reference/cases, e.g. `restitution/e0.5-v1-n50-clamp`.
+    pub name: String,
+    pub description: String,
+    /// The codes that compute the same model.
+    pub codes: Vec<Code>,
+    /// Part of `regen-reference --quick` (and of CI's check that the data are real).
+    pub quick: bool,
+    /// Keep the force-overlap curve.
+    pub curve: bool,
+}
+
+#[derive(Clone, Debug)]
+pub struct Case {
+    pub info: CaseInfo,
+    pub scene: Scene,
+}
+
+fn glass(restitution: f64) -> Material {
+    Material { restitution, ..Material::default() }
+}
+
+/// `1`, `0.1`, `10`: a number as it appears in case names.
+fn num(v: f64) -> String {
+    format!("{v}")
+}
+
+/// Every case of the workbench.
+pub fn cases() -> Vec<Case> {
+    let mut out = Vec::new();
+    for &e in &GRID_E {
+        for &v in &GRID_V {
+            for &n in &GRID_STEPS {
+                for clamp in [false, true] {
+                    let mut s = builtin::head_on(glass(e), 1e-3, v, n);
+                    s.model.limit_force = clamp;
+                    s.model.lever_arm = LeverArm::RadiusMinusHalfOverlap;
+                    let name = format!("restitution/e{}-v{}-n{}-{}", num(e), num(v), num(n), if clamp { "clamp" } else { "free" });
+                    s.name = name.replace('/', "-");
+                    s.description = format!("head-on glass beads r = 1 mm, e = {e}, v = {v} m/s, dt = t_c/{n}, Fn clamp {}", if clamp { "on" } else { "off" });
+                    let codes = if clamp { vec![Code::Liggghts, Code::Yade] } else { vec![Code::Liggghts] };
+                    let curve = n == 500.0 && v == 1.0 && [0.1, 0.5, 0.9].contains(&e);
+                    out.push(Case { info: CaseInfo { name, description: s.description.clone(), codes, quick: v == 1.0, curve }, scene: s });
+                }
+            }
+        }
+    }
+    for &a in &ANGLES {
+        for (target, builder) in [("wall", oblique_wall as fn(f64, TangentialSpec) -> Scene), ("pair", oblique_pair)] {
+            for (form, code) in [(TangentialSpec::TotalDisplacement, Code::Liggghts), (TangentialSpec::IncrementalForce, Code::Yade)] {
+                let mut s = builder(a, form);
+                let tag = if code == Code::Liggghts { "history" } else { "incremental" };
+                let name = format!("oblique-{target}/{tag}-a{}", num(a));
+                s.name = name.replace('/', "-");
+                out.push(Case { info: CaseInfo { name, description: s.description.clone(), codes: vec![code], quick: a == 45.0, curve: false }, scene: s });
+            }
+        }
+    }
+    let mut s = builtin::shear();
+    s.model.lever_arm = LeverArm::RadiusMinusHalfOverlap;
+    s.name = "shear-liggghts".into();
+    s.description = "the shear cell (built-in `shear`) with LIGGGHTS' lever arm".into();
+    s.output.frames = 0;
+    out.push(Case { info: CaseInfo { name: "shear/liggghts".into(), description: s.description.clone(), codes: vec![Code::Liggghts], quick: false, curve: false }, scene: s });
+    let mut s = builtin::shear();
+    matched(&mut s, TangentialSpec::IncrementalForce);
+    s.name = "shear-yade".into();
+    s.description = "the shear cell (built-in `shear`) with YADE's incremental tangential force, kinematics and clamp".into();
+    s.output.frames = 0;
+    out.push(Case { info: CaseInfo { name: "shear/yade".into(), description: s.description.clone(), codes: vec![Code::Yade], quick: false, curve: false }, scene: s });
+    out
+}
+
+/// Settings matched to the code that uses each tangential formulation: LIGGGHTS' lever
+/// arm r - dn/2 and no clamp (its defaults); YADE's ratcheting-free kinematics and the
+/// clamp it always applies.
+fn matched(s: &mut Scene, form: TangentialSpec) {
+    s.model.tangential = form;
+    let yade = form == TangentialSpec::IncrementalForce;
+    s.model.limit_force = yade;
+    s.model.lever_arm = if yade { LeverArm::Yade } else { LeverArm::RadiusMinusHalfOverlap };
+}
+
+/// A glass bead (r = 1 mm, e = 0.9, mu = 0.5) hitting a flat glass wall at 1 m/s, `a` degrees from the normal.
+pub fn oblique_wall(a: f64, form: TangentialSpec) -> Scene {
+    let mut s = builtin::oblique(glass(0.9), 1e-3, 1.0, a, form, 200.0);
+    matched(&mut s, form);
+    s.description = format!("glass bead on a flat glass wall at 1 m/s, {a} deg from the normal, e = 0.9, mu = 0.5, t_c/200");
+    s
+}
+
+/// A glass bead hitting a resting one at 1 m/s, `a` degrees between the approach and the
+/// line of centres at contact.
+pub fn oblique_pair(a: f64, form: TangentialSpec) -> Scene {
+    let mut s = builtin::oblique_pair(glass(0.9), 1e-3, 1.0, a, form, 200.0);
+    matched(&mut s, form);
+    s.description = format!("glass bead on a resting one at 1 m/s, {a} deg from the line of centres, e = 0.9, mu = 0.5, t_c/200");
+    s
+}
+
+/// Write every case (scene.json, case.json and each code's export) under `root`.
+pub fn write_cases(root: &Path, filter: Option<&str>) -> Result<usize, Error> {
+    let mut n = 0;
+    for c in cases() {
+        if filter.is_some_and(|f| !c.info.name.contains(f)) {
+            continue;
+        }
+        write_case(&root.join(&c.info.name), &c)?;
+        n += 1;
+    }
+    Ok(n)
+}
+
+pub fn write_case(dir: &Path, c: &Case) -> Result<(), Error> {
+    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir.display(), e))?;
+    let w = |name: &str, text: String| std::fs::write(dir.join(name), text).map_err(|e| Error::io(dir.join(name).display(), e));
+    w("scene.json", c.scene.to_json() + "\n")?;
+    w("case.json", serde_json::to_string_pretty(&c.info).expect("serialisable") + "\n")?;
+    for &code in &c.info.codes {
+        export(&c.scene, code, dir)?;
+    }
+    Ok(())
+}
+
+/// A case folder's `case.json` and `export.json`.
+pub(crate) fn read_info(case_dir: &Path) -> Result<(CaseInfo, ExportInfo), Error> {
+    let read = |name: &str| std::fs::read_to_string(case_dir.join(name)).map_err(|e| Error::io(case_dir.join(name).display(), e));
+    let case: CaseInfo = serde_json::from_str(&read("case.json")?).map_err(|e| Error::Other(format!("case.json: {e}")))?;
+    let info: ExportInfo = serde_json::from_str(&read("export.json")?).map_err(|e| Error::Other(format!("export.json: {e}")))?;
+    Ok((case, info))
+}
+
+/// Every case folder (holding a case.json) under `root`, sorted.
+pub fn case_dirs(root: &Path) -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    let mut stack = vec![root.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        if d.join("case.json").exists() {
+            out.push(d);
+            continue;
+        }
+        if let Ok(rd) = std::fs::read_dir(&d) {
+            for e in rd.flatten() {
+                if e.path().is_dir() {
+                    stack.push(e.path());
+                }
+            }
+        }
+    }
+    out.sort();
+    out
+}

@@ -1,0 +1,224 @@
+//! The comparison: the engine run on a case, its measurements held to each code's
+//! committed numbers with stated tolerances (impacts) or confidence intervals and
+//! Welch's test (shear).
+
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::Error;
+use crate::observe::impact::{CurvePoint, ImpactSummary};
+use crate::observe::stress::ShearSummary;
+use crate::scene::{Analysis, Scene};
+use crate::study::run::{RunOptions, run_scene};
+use crate::workbench::cases::read_info;
+use crate::workbench::export::Code;
+
+/// One compared quantity.
+#[derive(Clone, Debug, Serialize)]
+pub struct Row {
+    pub case: String,
+    pub code: Code,
+    pub quantity: String,
+    pub engine: f64,
+    pub reference: f64,
+    /// |engine - reference|.
+    pub abs_diff: f64,
+    /// |engine - reference| / |reference|.
+    pub rel_diff: f64,
+    /// The bound it is held to, and whether that is absolute or relative.
+    pub tolerance: f64,
+    pub relative: bool,
+    pub pass: bool,
+}
+
+impl Row {
+    fn new(case: &str, code: Code, quantity: &str, engine: f64, reference: f64, tolerance: f64, relative: bool) -> Row {
+        let abs_diff = (engine - reference).abs();
+        let rel_diff = abs_diff / reference.abs();
+        let d = if relative { rel_diff } else { abs_diff };
+        Row { case: case.into(), code, quantity: quantity.into(), engine, reference, abs_diff, rel_diff, tolerance, relative, pass: d <= tolerance }
+    }
+}
+
+/// The tolerances, with their reasons (docs/fidelity.md repeats them).
+pub mod tolerance {
+    /// Realised restitution, absolute: the same model at the same dt reproduces the
+    /// reference trajectory to rounding; 1e-5 is the issue's bound.
+    pub const RESTITUTION: f64 = 1e-5;
+    /// Peak force and largest overlap, relative (issue bound).
+    pub const PEAK: f64 = 1e-4;
+    /// Rebound spin and tangential velocity, relative (issue bound).
+    pub const SPIN: f64 = 1e-3;
+}
+
+/// The engine's impact summary for a case's scene.
+pub fn engine_impact(scene: &Scene) -> Result<ImpactSummary, Error> {
+    run_scene(scene, &RunOptions::default())?.impact.ok_or_else(|| Error::Other(format!("{}: no impact", scene.name)))
+}
+
+fn read_csv_row<T: for<'de> Deserialize<'de>>(path: &Path) -> Result<T, Error> {
+    let mut r = ::csv::Reader::from_path(path).map_err(|e| Error::Other(format!("{}: {e}", path.display())))?;
+    r.deserialize().next().ok_or_else(|| Error::Other(format!("{}: no row", path.display())))?.map_err(|e| Error::Other(format!("{}: {e}", path.display())))
+}
+
+/// The committed reference impact summary of a case.
+pub fn expected_impact(case_dir: &Path, code: Code) -> Result<ImpactSummary, Error> {
+    read_csv_row(&case_dir.join("expected").join(code.name()).join("impact.csv"))
+}
+
+/// The committed reference force-overlap curve of a case.
+pub fn expected_curve(case_dir: &Path, code: Code) -> Result<Vec<CurvePoint>, Error> {
+    let path = case_dir.join("expected").join(code.name()).join("force_overlap.csv");
+    let mut r = ::csv::Reader::from_path(&path).map_err(|e| Error::Other(format!("{}: {e}", path.display())))?;
+    r.deserialize().collect::<Result<Vec<CurvePoint>, _>>().map_err(|e| Error::Other(format!("{}: {e}", path.display())))
+}
+
+/// The committed reference shear estimates of a case.
+pub fn expected_shear(case_dir: &Path, code: Code) -> Result<ShearSummary, Error> {
+    let path = case_dir.join("expected").join(code.name()).join("shear.json");
+    let text = std::fs::read_to_string(&path).map_err(|e| Error::io(path.display(), e))?;
+    serde_json::from_str(&text).map_err(|e| Error::Other(format!("{}: {e}", path.display())))
+}
+
+/// Compare the engine's impact measurements with a reference's.
+pub fn compare_impact(case: &str, code: Code, engine: &ImpactSummary, reference: &ImpactSummary, oblique: bool) -> Vec<Row> {
+    let mut rows = vec![
+        Row::new(case, code, "restitution_normal", engine.restitution_normal, reference.restitution_normal, tolerance::RESTITUTION, false),
+        Row::new(case, code, "max_overlap_m", engine.max_overlap_m, reference.max_overlap_m, tolerance::PEAK, true),
+        Row::new(case, code, "peak_force_n", engine.peak_force_n, reference.peak_force_n, tolerance::PEAK, true),
+    ];
+    if oblique {
+        rows.push(Row::new(case, code, "rebound_spin_rad_s", engine.rebound_spin_rad_s, reference.rebound_spin_rad_s, tolerance::SPIN, true));
+        rows.push(Row::new(
+            case,
+            code,
+            "rebound_tangential_velocity_m_s",
+            engine.rebound_tangential_velocity_m_s,
+            reference.rebound_tangential_velocity_m_s,
+            tolerance::SPIN,
+            true,
+        ));
+    }
+    rows
+}
+
+/// Compare shear estimates: the difference of the means must lie inside the combined 95%
+/// interval `sqrt(ci_a^2 + ci_b^2)` (a Welch-type bound on two independent estimates).
+pub fn compare_shear(case: &str, code: Code, engine: &ShearSummary, reference: &ShearSummary) -> Vec<Row> {
+    // tau/sigma is undefined without a normal stress: then it cannot agree.
+    let undefined = crate::observe::stats::Estimate { mean: f64::NAN, ci95: f64::NAN, blocks: 0 };
+    let (ratio_a, ratio_b) = (engine.stress_ratio.unwrap_or(undefined), reference.stress_ratio.unwrap_or(undefined));
+    let pairs = [
+        ("shear_stress_pa", engine.shear_stress_pa, reference.shear_stress_pa),
+        ("normal_stress_pa", engine.normal_stress_pa, reference.normal_stress_pa),
+        ("stress_ratio", ratio_a, ratio_b),
+    ];
+    let mut rows: Vec<Row> = pairs.iter().map(|(q, a, b)| Row::new(case, code, q, a.mean, b.mean, (a.ci95 * a.ci95 + b.ci95 * b.ci95).sqrt(), false)).collect();
+    // Welch's t test on tau/sigma: the two block-average estimates have equal means unless
+    // p < 0.05. The row carries p as its "difference" from 1 so that the same pass rule
+    // (difference <= bound) reads p >= 0.05.
+    let p = welch_p(&ratio_a, &ratio_b);
+    let mut r = Row::new(case, code, "stress_ratio_welch_p_value", p, 1.0, 0.95, false);
+    r.pass = p >= 0.05;
+    rows.push(r);
+    rows
+}
+
+/// Two-sided p-value of Welch's t test for two block-average estimates (mean, 95% half
+/// width, number of blocks), with the Welch-Satterthwaite degrees of freedom (statrs).
+pub fn welch_p(a: &crate::observe::stats::Estimate, b: &crate::observe::stats::Estimate) -> f64 {
+    use statrs::distribution::{ContinuousCDF, StudentsT};
+    let se = |e: &crate::observe::stats::Estimate| {
+        let t = StudentsT::new(0.0, 1.0, (e.blocks.max(2) - 1) as f64).expect("dof >= 1").inverse_cdf(0.975);
+        e.ci95 / t
+    };
+    let (sa, sb) = (se(a), se(b));
+    let (va, vb) = (sa * sa, sb * sb);
+    if va + vb == 0.0 {
+        return if a.mean == b.mean { 1.0 } else { 0.0 };
+    }
+    let t = (a.mean - b.mean) / (va + vb).sqrt();
+    let (na, nb) = ((a.blocks.max(2) - 1) as f64, (b.blocks.max(2) - 1) as f64);
+    let dof = (va + vb).powi(2) / (va * va / na + vb * vb / nb);
+    let dist = StudentsT::new(0.0, 1.0, dof).expect("dof > 0");
+    2.0 * (1.0 - dist.cdf(t.abs()))
+}
+
+/// Run the engine on a committed case and compare it with every code that has data.
+pub fn compare_case(case_dir: &Path) -> Result<Vec<Row>, Error> {
+    let (case, _) = read_info(case_dir)?;
+    let text = std::fs::read_to_string(case_dir.join("scene.json")).map_err(|e| Error::io(case_dir.join("scene.json").display(), e))?;
+    let scene = Scene::from_json(&text)?;
+    let mut rows = Vec::new();
+    let codes: Vec<Code> = case.codes.iter().copied().filter(|c| case_dir.join("expected").join(c.name()).exists()).collect();
+    if codes.is_empty() {
+        return Ok(rows);
+    }
+    match scene.analysis {
+        Analysis::Impact => {
+            // One engine run gives the summary, and the curve when the case keeps one.
+            let (e, curve) = if case.curve {
+                let (s, c) = engine_impact_curve(&scene)?;
+                (s, Some(c))
+            } else {
+                (engine_impact(&scene)?, None)
+            };
+            let oblique = case.name.starts_with("oblique");
+            for code in codes {
+                rows.extend(compare_impact(&case.name, code, &e, &expected_impact(case_dir, code)?, oblique));
+                // The force-overlap curve on a common normalised grid (50 overlaps per
+                // branch), its largest difference as a fraction of the peak force.
+                if let Some(c) = &curve {
+                    let d = curve_difference(c, &expected_curve(case_dir, code)?, 50);
+                    rows.push(Row::new(&case.name, code, "force_overlap_curve_diff_of_peak", d, 0.0, tolerance::PEAK, false));
+                }
+            }
+        }
+        Analysis::Shear => {
+            let s = run_scene(&scene, &RunOptions::default())?.shear.ok_or_else(|| Error::Other("no shear summary".into()))?;
+            for code in codes {
+                rows.extend(compare_shear(&case.name, code, &s, &expected_shear(case_dir, code)?));
+            }
+        }
+        Analysis::None => {}
+    }
+    Ok(rows)
+}
+
+/// The engine's impact summary and force-overlap curve for a scene.
+pub fn engine_impact_curve(scene: &Scene) -> Result<(ImpactSummary, Vec<CurvePoint>), Error> {
+    let mut built = crate::study::build(scene)?;
+    let obs = crate::study::accuracy::step_impact(&mut built, scene)?;
+    let s = obs.summary().ok_or_else(|| Error::Other(format!("{}: no impact", scene.name)))?;
+    Ok((s, obs.curve))
+}
+
+/// Largest difference of two force-overlap curves on a common normalised grid: overlap
+/// over the reference's largest overlap, force over its peak force, compared at `points`
+/// overlaps on the loading branch and on the unloading branch (linear interpolation), as
+/// a fraction of the peak force.
+pub fn curve_difference(engine: &[CurvePoint], reference: &[CurvePoint], points: usize) -> f64 {
+    let peak = |c: &[CurvePoint]| c.iter().enumerate().max_by(|a, b| a.1.overlap_m.total_cmp(&b.1.overlap_m)).map(|(k, _)| k).unwrap_or(0);
+    let dmax = reference.iter().map(|c| c.overlap_m).fold(0.0, f64::max);
+    let fmax = reference.iter().map(|c| c.normal_force_n).fold(0.0, f64::max);
+    // Force at overlap `d` on one branch (overlaps monotonic along it).
+    let at = |branch: &[CurvePoint], d: f64| -> Option<f64> {
+        branch.windows(2).find_map(|w| {
+            let (a, b) = (w[0], w[1]);
+            let (lo, hi) = (a.overlap_m.min(b.overlap_m), a.overlap_m.max(b.overlap_m));
+            (d >= lo && d <= hi && hi > lo).then(|| a.normal_force_n + (b.normal_force_n - a.normal_force_n) * (d - a.overlap_m) / (b.overlap_m - a.overlap_m))
+        })
+    };
+    let (ke, kr) = (peak(engine), peak(reference));
+    let mut worst: f64 = 0.0;
+    for (be, br) in [(&engine[..=ke], &reference[..=kr]), (&engine[ke..], &reference[kr..])] {
+        for k in 1..points {
+            let d = dmax * k as f64 / points as f64;
+            if let (Some(a), Some(b)) = (at(be, d), at(br, d)) {
+                worst = worst.max((a - b).abs() / fmax);
+            }
+        }
+    }
+    worst
+}

@@ -1,0 +1,109 @@
+//! The digest: a reference code's raw output (`series.txt`, `walls.txt`) measured with
+//! the engine's own observers, the same estimators on both sides, into the case's
+//! `expected/<code>/`.
+
+use std::path::{Path, PathBuf};
+
+use crate::error::Error;
+use crate::observe::impact::{ImpactObserver, ImpactState, ImpactSummary};
+use crate::observe::stress::{WallRow, stress_estimates};
+use crate::output::csv::CsvSeries;
+use crate::physics::boundary::Boundary;
+use crate::physics::dim::Vec2;
+use crate::scene::Analysis;
+use crate::workbench::cases::read_info;
+use crate::workbench::export::{Code, ExportInfo};
+
+/// Read a whitespace table with a header line (series.txt, walls.txt).
+fn read_table(path: &Path) -> Result<(Vec<String>, Vec<Vec<f64>>), Error> {
+    let text = std::fs::read_to_string(path).map_err(|e| Error::io(path.display(), e))?;
+    let mut lines = text.lines().filter(|l| !l.trim().is_empty());
+    let header: Vec<String> = lines.next().ok_or_else(|| Error::Other(format!("{}: empty", path.display())))?.split_whitespace().map(String::from).collect();
+    let mut rows = Vec::new();
+    for (k, l) in lines.enumerate() {
+        let row: Result<Vec<f64>, _> = l.split_whitespace().map(str::parse::<f64>).collect();
+        let row = row.map_err(|_| Error::Other(format!("{}:{}: not a row of numbers: `{l}`", path.display(), k + 2)))?;
+        if row.len() != header.len() {
+            return Err(Error::Other(format!("{}:{}: {} values for {} columns", path.display(), k + 2, row.len(), header.len())));
+        }
+        rows.push(row);
+    }
+    Ok((header, rows))
+}
+
+/// Measure a reference code's raw output (in `run_dir`) with the engine's observers and
+/// write `expected/<code>/` in `case_dir`.
+pub fn digest(case_dir: &Path, code: Code, run_dir: &Path) -> Result<PathBuf, Error> {
+    let (case, info) = read_info(case_dir)?;
+    let out = case_dir.join("expected").join(code.name());
+    std::fs::create_dir_all(&out).map_err(|e| Error::io(out.display(), e))?;
+    match info.analysis {
+        Analysis::Impact => {
+            let (obs, summary) = impact_of_series(&info, &run_dir.join("series.txt"))?;
+            CsvSeries::create(&out.join("impact.csv"))?.row(&summary)?;
+            if case.curve {
+                let mut w = CsvSeries::create(&out.join("force_overlap.csv"))?;
+                for p in &obs.curve {
+                    w.row(p)?;
+                }
+            }
+        }
+        Analysis::Shear => {
+            let (_, rows) = read_table(&run_dir.join("walls.txt"))?;
+            let series: Vec<WallRow> = rows
+                .iter()
+                .map(|r| WallRow::new(r[0] * info.time_step_s, Vec2::new(r[1], r[2]), Vec2::new(r[3], r[4]), r[5], info.length_m, info.depth_m))
+                .collect();
+            if series.len() < 4 {
+                return Err(Error::Other(format!("{}: fewer than 4 rows", run_dir.join("walls.txt").display())));
+            }
+            let mut w = CsvSeries::create(&out.join("stress.csv"))?;
+            for r in &series {
+                w.row(r)?;
+            }
+            std::fs::write(out.join("shear.json"), serde_json::to_string_pretty(&stress_estimates(&series, None)).expect("serialisable") + "\n")
+                .map_err(|e| Error::io(out.display(), e))?;
+        }
+        Analysis::None => return Err(Error::Other("export.json: analysis none".into())),
+    }
+    Ok(out)
+}
+
+/// Run the impact observer over a series.txt.
+pub fn impact_of_series(info: &ExportInfo, path: &Path) -> Result<(ImpactObserver, ImpactSummary), Error> {
+    let (header, rows) = read_table(path)?;
+    if header != info.columns {
+        return Err(Error::Other(format!("{}: columns {:?}, expected {:?}", path.display(), header, info.columns)));
+    }
+    let two = info.radii_m.len() == 2;
+    let j = if two { 1 } else { 0 };
+    let state = |r: &[f64]| {
+        let g = |k: usize| (Vec2::new(r[1 + 7 * k], r[2 + 7 * k]), Vec2::new(r[3 + 7 * k], r[4 + 7 * k]), r[5 + 7 * k]);
+        let (x0, v0, w0) = g(0);
+        let (x1, v1, w1) = g(j);
+        let m = &info.masses_kg;
+        let momentum = if two { m[0] * v0 + m[1] * v1 } else { m[0] * v0 };
+        let scale = m[0] * v0.norm() + if two { m[1] * v1.norm() } else { 0.0 };
+        ImpactState {
+            time: r[0] * info.time_step_s,
+            x: [x0, x1],
+            v: [v0, v1],
+            omega: [w0, w1],
+            r: [info.radii_m[0], info.radii_m[j]],
+            f0: Vec2::new(r[6], r[7]),
+            wall: info.flat_wall.map(|[y, side, vx]| (y, side, Vec2::new(vx, 0.0))),
+            boundary: Boundary::open(),
+            momentum,
+            momentum_scale: scale,
+        }
+    };
+    let mut obs = ImpactObserver::default();
+    let mut it = rows.iter();
+    let first = it.next().ok_or_else(|| Error::Other(format!("{}: no rows", path.display())))?;
+    obs.start_state(&state(first));
+    for r in it {
+        obs.observe_state(&state(r));
+    }
+    let s = obs.summary().ok_or_else(|| Error::Other(format!("{}: the grains did not touch and separate", path.display())))?;
+    Ok((obs, s))
+}

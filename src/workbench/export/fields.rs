@@ -1,0 +1,409 @@
+//! What every scene field becomes in each reference code's deck: the one table the
+//! exporter and its test go by.
+//!
+//! Each leaf of the scene schema (a JSON path; list elements written `[]`, every enum
+//! variant's fields included, a unit variant's choice at the enum's own path) has one
+//! [`Decision`] per code:
+//! - **written**: the value goes into the deck, `grains.data` or `export.json` (the text
+//!   says where);
+//! - **refused**: values the code cannot express are refused by name, as
+//!   `export to CODE: PATH = VALUE cannot be expressed: WHY` ([`refuse`]);
+//! - **differs**: the deck knowingly computes something else for some values, and says so
+//!   in a line `# Differs: PATH = VALUE: WHAT` ([`differs_line`]);
+//! - **outside**: not part of the physics a deck computes (the text says why it is fine
+//!   to leave out); changing it leaves the exported files as they are;
+//! - **one value**: scene validation admits a single value, which the deck expresses.
+//!
+//! A field may be written for some values and refused for others, or written with a
+//! Differs note. `tests/export_fields.rs` derives the scene's JSON schema (schemars),
+//! requires a decision here for every leaf and no entry without a leaf, and checks each
+//! decision on scenes with that field changed: a scene field added without a decision,
+//! or a decision the exporter does not keep, fails it. `grainlab export CODE
+//! --explain-fields` prints the table of one code.
+
+use std::fmt::Write as _;
+
+use super::common::Code;
+use crate::error::Error;
+
+/// What one scene field becomes in one code's deck (see the module documentation).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Decision {
+    /// Where the value goes.
+    pub written: Option<&'static str>,
+    /// Which values are refused, and why.
+    pub refused: Option<&'static str>,
+    /// For which values the deck computes something else, and what (a `# Differs:` line).
+    pub differs: Option<(&'static str, &'static str)>,
+    /// Why the field may be left out.
+    pub outside: Option<&'static str>,
+    /// The one value validation admits, and what the deck does with it.
+    pub one_value: Option<&'static str>,
+}
+
+const NONE: Decision = Decision { written: None, refused: None, differs: None, outside: None, one_value: None };
+
+const fn written(to: &'static str) -> Decision {
+    Decision { written: Some(to), ..NONE }
+}
+const fn refused(why: &'static str) -> Decision {
+    Decision { refused: Some(why), ..NONE }
+}
+const fn differs(when: &'static str, what: &'static str) -> Decision {
+    Decision { differs: Some((when, what)), ..NONE }
+}
+const fn outside(why: &'static str) -> Decision {
+    Decision { outside: Some(why), ..NONE }
+}
+const fn one_value(what: &'static str) -> Decision {
+    Decision { one_value: Some(what), ..NONE }
+}
+
+impl Decision {
+    /// Also refuse some values.
+    const fn or_refused(self, why: &'static str) -> Decision {
+        Decision { refused: Some(why), ..self }
+    }
+    /// Also note a difference for some values.
+    const fn or_differs(self, when: &'static str, what: &'static str) -> Decision {
+        Decision { differs: Some((when, what)), ..self }
+    }
+}
+
+/// One scene field and what it becomes in each code.
+#[derive(Clone, Copy, Debug)]
+pub struct Field {
+    /// JSON path, list elements as `[]`.
+    pub path: &'static str,
+    pub liggghts: Decision,
+    pub yade: Decision,
+}
+
+impl Field {
+    pub fn decision(&self, code: Code) -> &Decision {
+        match code {
+            Code::Liggghts => &self.liggghts,
+            Code::Yade => &self.yade,
+        }
+    }
+}
+
+const fn both(path: &'static str, d: Decision) -> Field {
+    Field { path, liggghts: d, yade: d }
+}
+const fn each(path: &'static str, liggghts: Decision, yade: Decision) -> Field {
+    Field { path, liggghts, yade }
+}
+
+const NAME_L: &str = "the comments of in.liggghts, the title line of grains.data, export.json `scene`; escaped to printable ASCII on one line (`\\`, quotes, control and non-ASCII characters as Rust escapes, `&` as `\\u{26}`): no line break starts a command and no comment ends in `&`, which would continue it onto the next line";
+const NAME_Y: &str = "the comments of yade.py, the title line of grains.data, export.json `scene`; escaped to printable ASCII on one line (`\\`, quotes, control and non-ASCII characters as Rust escapes): no line break starts a Python statement";
+const PACKED: &str = "grains.data: grainlab generates the packing once, so both codes start from the same grains";
+const RULE_L: &str = "resolved into dt: `timestep DT` and `run N` (N = ceil(duration / dt)), export.json time_step_s";
+const RULE_Y: &str = "resolved into dt: `O.dt = DT` and STEPS (N = ceil(duration / dt)), export.json time_step_s";
+const Y_L: &str = "flat: `fix wall/gran ... primitive yplane Y`; rough: the row's atoms in grains.data";
+const Y_Y: &str = "flat: `wall(Y, axis=1)`; rough: the row's spheres in grains.data";
+const VX_L: &str = "flat: `shear x V` on the wall/gran fix; rough: the row's velocities in grains.data, kept by `setforce 0.0 ...` and nve";
+const VX_Y: &str = "flat: the wall body's state.vel; rough: the row's velocities in grains.data, kept by blockedDOFs (the loaded row as a clump)";
+const SURFACE_L: &str = "flat: a primitive `wall/gran` plane (R* = r, m* = m, as grainlab); rough: a row of atoms in grains.data moved as one (setforce + nve)";
+const SURFACE_Y: &str = "flat: a `wall` body with Ig2_Wall_Sphere_ScGeom(hertzian=True); rough: the row's spheres from grains.data, blocked at their velocity (`xyzXYZ`), the loaded top row one clump";
+const FLAT_IN_SHEAR: &str = "a flat wall in a shear scene: the shear decks measure the forces on the rows of rough walls";
+const FLAT_Y: &str = "YADE's hertzian wall has a large finite radius, so R* and the ratcheting factor differ from a plane's by O(r / R_wall) (2e-9 relative on the oblique impacts)";
+const ROUGH_R: &str = "grains.data: the row's atoms (their number and diameter)";
+const MATERIAL_L: &str = "flat: the wall/gran fix's atom type (material + 1); rough: the row's atom type in grains.data";
+const MATERIAL_Y: &str = "flat: the wall body's material mats[k]; rough: the row's atom type in grains.data";
+const BOTTOM_CONTROL: &str = "\"fixed\": only the top wall carries a load (scene validation refuses a pressure on the bottom wall); the decks hold the bottom wall (a fixed plane, or a row at constant velocity)";
+const BOTTOM_MASS: &str = "the bottom wall is always held in y (only the top wall carries a load), so its mass has no effect, in grainlab either";
+const THICKNESS: &str = "export.json depth_m (wall forces to stresses), and the load p L_x t on a loaded top wall";
+const LIST_X: &str = "grains.data Atoms: x y (z = 0)";
+const LIST_V: &str = "grains.data Velocities: vx vy";
+const LIST_R: &str = "grains.data Atoms: diameter 2 r";
+const ATOM_TYPE: &str = "grains.data atom type (material + 1)";
+const SPIN_NO_ROTATION: &str = "a non-zero spin with model.rotation = false (and friction): grainlab's grain-grain contacts then leave the spin out of the contact velocity, LIGGGHTS (`nve`) and YADE (blocked rotation) keep the spin, which never changes, in it";
+const NOT_PHYSICS_OUTPUT: &str = "grainlab's own output";
+
+/// Every leaf of the scene schema and its decision for each code.
+pub const FIELDS: &[Field] = &[
+    each("name", written(NAME_L), written(NAME_Y)),
+    both("description", outside("free text: no physics, not written (the decks name the scene by its name)")),
+    each(
+        "grain_shape",
+        refused("\"disk\": not exported yet; the deck writes spheres at z = 0 (sphere_in_plane: mass 4/3 pi r^3 rho, inertia 2/5 m r^2), and LIGGGHTS' `dimension 2` disks (pi r^2 rho per metre, m r^2 / 2) would need a deck of their own (enforce2d, density times thickness), not written nor checked against LIGGGHTS"),
+        refused("\"disk\": YADE's spheres with blockedDOFs 'zXY' are the sphere_in_plane model (mass 4/3 pi r^3 rho, inertia 2/5 m r^2); this contact law has no disk of a stated thickness there"),
+    ),
+    each(
+        "grain_shape.disk.thickness",
+        refused("disks are not exported yet (see grain_shape)"),
+        refused("disks cannot be expressed (see grain_shape)"),
+    ),
+    both("materials[].name", outside("a label: the decks refer to materials by position (LIGGGHTS atom type k + 1, YADE mats[k])")),
+    each("materials[].youngs_modulus", written("`fix m1 ... youngsModulus peratomtype`"), written("E[k], FrictMat(young)")),
+    each(
+        "materials[].poisson_ratio",
+        written("`fix m2 ... poissonsRatio peratomtype` (LIGGGHTS mixes E* and G* as grainlab)"),
+        written("NU[k], FrictMat(poisson) (YADE 2023.02 mixes E* and G* as grainlab)"),
+    ),
+    each(
+        "materials[].density",
+        written("grains.data density column (atom mass 4/3 pi r^3 rho)"),
+        written("RHO[k], FrictMat(density): sphere mass 4/3 pi r^3 rho"),
+    ),
+    each(
+        "materials[].restitution",
+        written("`fix m3 ... coefficientRestitution peratomtypepair`, each pair the smaller e (grainlab's rule)"),
+        written("BETA = sqrt(5/6) |beta(e)| as Ip2_FrictMat_FrictMat_MindlinPhys(betan = betas = BETA), never `en` (a different damping fit)")
+            .or_refused("materials of different restitution: YADE's Ip2_FrictMat_FrictMat_MindlinPhys takes one betan for every pair"),
+    ),
+    each(
+        "materials[].friction",
+        written("`fix m4 ... coefficientFriction peratomtypepair`, each pair the smaller mu (0 when frictionless)"),
+        written("MU[k], FrictMat(frictionAngle = atan(mu)): YADE takes the pair's smaller angle (0 when frictionless)"),
+    ),
+    each(
+        "domain.periodic_x",
+        written("`boundary p f f` and the box's x bounds in grains.data"),
+        written("a periodic cell of length L from x_min (y and z 10x the packing: YADE cells are periodic in every direction)")
+            .or_refused("an impact scene, or a scene without two rough walls: YADE's periodic script is the shear cell's (rough rows, the top one loaded or held); or a cell shorter than 4 r_max + 2 r_min: YADE's periodic collider stops on a body whose bounds (its diameter and twice the Verlet distance, by default half the smallest radius) span over half the cell"),
+    ),
+    both("grains.list[].x", written(LIST_X)),
+    both("grains.list[].v", written(LIST_V)),
+    both("grains.list[].omega", written("grains.data Velocities: wz").or_refused(SPIN_NO_ROTATION)),
+    both("grains.list[].r", written(LIST_R)),
+    both("grains.list[].material", written(ATOM_TYPE)),
+    both("grains.file.path", written("grains.data: grainlab reads the file and writes its grains (the decks never read the path)")),
+    both("grains.file.columns", outside("the grain file's format: the grains grainlab reads with it are written to grains.data (see grains.file.path); the same file read with other columns is refused, so a change of it alone never reaches a deck")),
+    both("grains.file.material", written(ATOM_TYPE)),
+    both("grains.pack.count", written(PACKED)),
+    both("grains.pack.radius.fixed.radius", written(PACKED)),
+    both("grains.pack.radius.uniform.min", written(PACKED)),
+    both("grains.pack.radius.uniform.max", written(PACKED)),
+    both("grains.pack.radius.normal.mean", written(PACKED)),
+    both("grains.pack.radius.normal.std", written(PACKED)),
+    both("grains.pack.radius.normal.min", written(PACKED)),
+    both("grains.pack.radius.normal.max", written(PACKED)),
+    both("grains.pack.radius.lognormal.median", written(PACKED)),
+    both("grains.pack.radius.lognormal.sigma", written(PACKED)),
+    both("grains.pack.radius.lognormal.min", written(PACKED)),
+    both("grains.pack.radius.lognormal.max", written(PACKED)),
+    both("grains.pack.seed", written(PACKED)),
+    both("grains.pack.material", written(ATOM_TYPE)),
+    both("grains.pack.x", written(PACKED)),
+    both("grains.pack.y_min", written(PACKED)),
+    both("grains.pack.packing_fraction", written(PACKED)),
+    each("walls.bottom.y", written(Y_L), written(Y_Y)),
+    each("walls.bottom.velocity_x", written(VX_L), written(VX_Y)),
+    each(
+        "walls.bottom.surface",
+        written(SURFACE_L).or_refused(FLAT_IN_SHEAR),
+        written(SURFACE_Y).or_refused(FLAT_IN_SHEAR).or_differs("flat", FLAT_Y),
+    ),
+    both("walls.bottom.surface.rough.radius", written(ROUGH_R)),
+    both("walls.bottom.control", one_value(BOTTOM_CONTROL)),
+    both("walls.bottom.control.pressure", one_value(BOTTOM_CONTROL)),
+    both("walls.bottom.mass", outside(BOTTOM_MASS)),
+    each("walls.bottom.material", written(MATERIAL_L), written(MATERIAL_Y)),
+    each("walls.top.y", written(Y_L), written(Y_Y)),
+    each("walls.top.velocity_x", written(VX_L), written(VX_Y)),
+    each(
+        "walls.top.surface",
+        written(SURFACE_L).or_refused(FLAT_IN_SHEAR),
+        written(SURFACE_Y).or_refused(FLAT_IN_SHEAR).or_differs("flat", FLAT_Y),
+    ),
+    both("walls.top.surface.rough.radius", written(ROUGH_R)),
+    each(
+        "walls.top.control",
+        written("\"fixed\": a fixed plane, or `setforce 0.0 0.0 0.0` on the row").or_refused("a load on a flat wall (see walls.top.control.pressure)"),
+        written("\"fixed\": a fixed wall body, or the row blocked at its velocity").or_refused("a load on a flat wall, or without a periodic x (see walls.top.control.pressure)"),
+    ),
+    each(
+        "walls.top.control.pressure",
+        written("the load p L_x t on the rough row: `setforce 0.0 NULL 0.0`, `aveforce NULL -F/n NULL` (per atom) and nve move it as one body of its atoms' mass")
+            .or_refused("on a flat wall: a primitive wall/gran plane cannot carry a load; use a rough wall"),
+        written("LOAD = p L_x t, a permanent force on the top row's clump (blockedDOFs 'xzXYZ')")
+            .or_refused("on a flat wall (a wall body cannot carry a load; use a rough wall), or without a periodic x (the script moves a loaded row in the periodic cell only, and holds rough rows elsewhere)")
+            .or_differs("any", "YADE's leapfrog takes the initial velocities as v(-1/2), grainlab's velocity Verlet as v(0): bodies under a force at t = 0 (the loaded wall, touching grains) start O(a dt^2) apart, which a flow forgets"),
+    ),
+    each(
+        "walls.top.mass",
+        refused("a loaded top wall whose mass differs from its row's atoms' total beyond rounding (1e-12): LIGGGHTS moves the row as its atoms (nve, aveforce), and another atom density would change the contact damping (m*); a fixed wall's mass has no effect, in grainlab either"),
+        written("a loaded top row: the clump's state.mass (NewtonIntegrator accelerates a clump by F / state.mass; its spheres keep their own masses in the contact damping, as grainlab's glued grains); a fixed wall's mass has no effect, in grainlab either"),
+    ),
+    each("walls.top.material", written(MATERIAL_L), written(MATERIAL_Y)),
+    both("walls.thickness", written(THICKNESS)),
+    each(
+        "gravity",
+        refused("not exported yet: grainlab pulls the free grains only, and a `fix gravity` on the free group has not been checked against it"),
+        refused("not exported yet: NewtonIntegrator's gravity would also pull the loaded wall's clump, which grainlab's gravity does not"),
+    ),
+    each(
+        "model.tangential",
+        written("total_displacement: `pair_style gran model hertz tangential history`; frictionless: coefficientFriction 0 (Ft = 0) and `nve`")
+            .or_differs("incremental_force", "LIGGGHTS has only the total-displacement history; head-on impacts agree, oblique ones differ (rebound spin up to 2x)"),
+        written("incremental_force: Law2_ScGeom_MindlinPhys_Mindlin; frictionless: frictionAngle 0 (Ft = 0)")
+            .or_differs("total_displacement", "YADE's Mindlin law adds force increments; head-on impacts agree, oblique ones differ (rebound spin up to 2x)"),
+    ),
+    each(
+        "model.limit_force",
+        written("`limitForce on` in the pair style and the wall/gran fixes"),
+        differs("false", "YADE always clamps Fn >= 0 (the realised restitution is higher, most for small e)"),
+    ),
+    each(
+        "model.lever_arm",
+        differs("radius, yade", "LIGGGHTS' arm is r - dn/2, in the torque and in the contact velocity (lever_arm radius_minus_half_overlap); torques and tangential velocities differ by O(dn/r)"),
+        differs("radius, radius_minus_half_overlap", "YADE's ScGeom kinematics are lever_arm yade (full radii for the spins in the contact velocity, its translational part scaled by (r1 + r2) / (r1 + r2 - dn), torque arm r - dn/2, r - dn on a wall); torques and tangential velocities differ by O(dn/r)"),
+    ),
+    each(
+        "model.rotation",
+        written("false: `fix nve` for the free grains instead of `nve/sphere`"),
+        written("false: blockedDOFs 'zXYZ' for the free grains instead of 'zXY'"),
+    ),
+    each(
+        "model.general_damping",
+        refused("grainlab's drag is F = -c m v and M = -c I w on each free grain; LIGGGHTS' `fix viscous` applies -gamma v with one gamma per atom type and no torque"),
+        refused("grainlab's drag is F = -c m v and M = -c I w on each free grain; NewtonIntegrator's damping is Cundall's non-viscous damping (the force scaled by 1 - d sign(F v)), LinearDragEngine a Stokes drag 6 pi nu r v without torque"),
+    ),
+    each("time_step.rule.fixed.dt", written(RULE_L), written(RULE_Y)),
+    each("time_step.rule.steps_per_contact.steps", written(RULE_L), written(RULE_Y)),
+    each("time_step.rule.steps_per_contact.impact_speed", written(RULE_L), written(RULE_Y)),
+    each("time_step.rule.rayleigh_fraction.fraction", written(RULE_L), written(RULE_Y)),
+    each("time_step.rule.seed_rule.factor", written(RULE_L), written(RULE_Y)),
+    each("time_step.rule.seed_rule.reference_overlap", written(RULE_L), written(RULE_Y)),
+    each("time_step.rule.accuracy.quantity", written(RULE_L), written(RULE_Y)),
+    each("time_step.rule.accuracy.tolerance", written(RULE_L), written(RULE_Y)),
+    each("time_step.rule.accuracy.impact_speed", written(RULE_L), written(RULE_Y)),
+    both(
+        "time_step.characteristic_speed",
+        outside("sets grainlab's stability check and the reported steps per contact only; the deck takes the resolved dt"),
+    ),
+    both("time_step.allow_unstable", outside("grainlab's guard against a dt above the stability limit; the deck takes the same dt either way")),
+    each(
+        "duration",
+        written("`run N` (N = ceil(duration / dt)), export.json steps, and the box's margins in grains.data"),
+        written("STEPS (N = ceil(duration / dt)), export.json steps, and the margins in grains.data"),
+    ),
+    each(
+        "neighbor.skin",
+        written("`neighbor SKIN bin`, SKIN = skin x the smallest free grain's diameter"),
+        outside("a neighbour-list setting: the contacts found do not depend on it, and YADE sizes its own Verlet distance"),
+    ),
+    each(
+        "output.samples",
+        written("steps per walls.txt row (shear decks: `fix ave/time` and `fix print`), export.json sample_every; impact decks record every step"),
+        written("steps per walls.txt row (shear scripts: SAMPLE), export.json sample_every; impact scripts record every step"),
+    ),
+    both("output.frames", outside(NOT_PHYSICS_OUTPUT)),
+    both("output.energy", outside("grainlab's energy ledger, a compile-time switch that leaves the forces as they are; the decks record states and forces")),
+    both(
+        "analysis",
+        written("what the deck records: impact, series.txt at every step; shear, walls.txt; none, nothing (a deck to time or to watch); export.json analysis and columns (an impact without two grains, or a grain and a flat wall, is refused by the scene's own checks)"),
+    ),
+];
+
+/// The normalised path of a concrete one: list indices `[k]` become `[]`.
+pub fn normalise(path: &str) -> String {
+    let mut out = String::with_capacity(path.len());
+    let mut in_index = false;
+    for c in path.chars() {
+        match c {
+            '[' => {
+                in_index = true;
+                out.push('[');
+            }
+            ']' => {
+                in_index = false;
+                out.push(']');
+            }
+            _ if in_index => {}
+            _ => out.push(c),
+        }
+    }
+    out
+}
+
+/// The table's entry for a (concrete or normalised) path.
+pub fn field(path: &str) -> Option<&'static Field> {
+    let p = normalise(path);
+    FIELDS.iter().find(|f| f.path == p)
+}
+
+fn entry(path: &str) -> &'static Field {
+    field(path).unwrap_or_else(|| panic!("src/export/fields.rs has no entry for `{path}`"))
+}
+
+/// The refusal of `path = value` for `code`, with the table's reason and what this scene
+/// adds (`detail`, may be empty).
+pub fn refuse(code: Code, path: &str, value: impl std::fmt::Display, detail: &str) -> Error {
+    let why = entry(path).decision(code).refused.unwrap_or_else(|| panic!("src/export/fields.rs: {path} is refused for {} without a reason", code.name()));
+    let detail = if detail.is_empty() { String::new() } else { format!(" ({detail})") };
+    Error::Export(format!("export to {}: {path} = {value} cannot be expressed: {why}{detail}", code.name()))
+}
+
+/// The table's note of what `code` does differently for `path`.
+pub fn note(code: Code, path: &str) -> &'static str {
+    entry(path).decision(code).differs.unwrap_or_else(|| panic!("src/export/fields.rs: {path} differs for {} without a note", code.name())).1
+}
+
+/// The deck comment `# Differs: path = value: what` with the table's text (the caller
+/// writes it for the values that differ).
+pub fn differs_line(code: Code, path: &str, value: impl std::fmt::Display) -> String {
+    format!("# Differs: {path} = {value}: {}", note(code, path))
+}
+
+/// The table of one code, grouped: what it cannot express first.
+pub fn explain(code: Code) -> String {
+    let mut s = String::new();
+    let _ = writeln!(s, "export to {}: what each scene field becomes (src/export/fields.rs)", code.name());
+    // Each group's title and its (values, text) of a decision.
+    type Pick = fn(&Decision) -> Option<(&'static str, &'static str)>;
+    let groups: [(&str, Pick); 5] = [
+        ("cannot be expressed (refused, naming the field)", |d| d.refused.map(|t| ("", t))),
+        ("expressed approximately (a `# Differs:` line in the deck)", |d| d.differs),
+        ("written", |d| d.written.map(|t| ("", t))),
+        ("not part of the physics the deck computes", |d| d.outside.map(|t| ("", t))),
+        ("one valid value", |d| d.one_value.map(|t| ("", t))),
+    ];
+    for (title, pick) in groups {
+        let _ = writeln!(s, "\n{title}:");
+        for f in FIELDS {
+            if let Some((when, text)) = pick(f.decision(code)) {
+                let when = if when.is_empty() { String::new() } else { format!(" = {when}") };
+                let _ = writeln!(s, "  {}{when}: {text}", f.path);
+            }
+        }
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn paths_are_unique_and_every_decision_says_something() {
+        for (k, f) in FIELDS.iter().enumerate() {
+            assert!(FIELDS[..k].iter().all(|g| g.path != f.path), "{} twice", f.path);
+            for code in [Code::Liggghts, Code::Yade] {
+                let d = f.decision(code);
+                // A field is written, refused, outside or of one value; a Differs note
+                // alone is a decision too (the code does it its own way).
+                assert!(d.written.is_some() || d.refused.is_some() || d.outside.is_some() || d.one_value.is_some() || d.differs.is_some(), "{} {:?}", f.path, code);
+                // Outside and one-value fields are neither written nor refused.
+                if d.outside.is_some() || d.one_value.is_some() {
+                    assert!(d.written.is_none() && d.refused.is_none() && d.differs.is_none(), "{} {:?}", f.path, code);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn indices_are_normalised() {
+        assert_eq!(normalise("materials[12].restitution"), "materials[].restitution");
+        assert_eq!(normalise("grains.list[0].x"), "grains.list[].x");
+        assert_eq!(field("walls.top.mass").map(|f| f.path), Some("walls.top.mass"));
+    }
+
+    #[test]
+    fn a_refusal_names_code_path_value_and_reason() {
+        let e = refuse(Code::Liggghts, "model.general_damping", 0.1, "").to_string();
+        assert!(e.contains("export to liggghts: model.general_damping = 0.1 cannot be expressed: ") && e.contains("fix viscous"), "{e}");
+    }
+}

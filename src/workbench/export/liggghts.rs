@@ -1,0 +1,164 @@
+//! The LIGGGHTS 3.8 input deck of a scene.
+//!
+//! Model: `pair_style gran model hertz tangential history`, with `limitForce on` when
+//! the scene clamps Fn >= 0; flat walls are primitive `wall/gran` planes (R* = r,
+//! m* = m), rough walls are rows of atoms moved as rigid rows (`setforce` + `nve`, the
+//! top row pushed by `aveforce` for a constant load, its total mass that of the row).
+//! The traps of reference-notes.md are handled here: `hard_particles yes`, `atom_modify
+//! map array`, `communicate single vel yes`, `newton off`, `neigh_modify delay 0`,
+//! per-type material matrices that include wall types, `aveforce` per atom.
+//!
+//! The scene name enters comments only, escaped (`comment`). What the deck cannot
+//! express is refused and what it expresses approximately is noted, both as
+//! [`super::fields`] says.
+
+use std::fmt::Write as _;
+
+use super::fields::{differs_line, refuse};
+use super::common::{Code, escaped, f};
+use super::prepare::Exported;
+use crate::error::Error;
+use crate::physics::contact::LeverArm;
+use crate::physics::material::PairMaterial;
+use crate::physics::walls::{Control, Surface};
+use crate::scene::{Analysis, Scene, TangentialSpec};
+
+pub(crate) fn deck(scene: &Scene, ex: &Exported) -> Result<String, Error> {
+    let model = &scene.model;
+    let e = ex.built.engine.as_ref();
+    let p = e.particles();
+    let info = &ex.info;
+    let mats = &scene.materials;
+    let n = mats.len();
+    let mut s = String::new();
+    let w = &mut s;
+    let _ = writeln!(w, "# LIGGGHTS 3.8.0 deck exported by grainlab {} from scene `{}`. Generated: do not edit;", env!("CARGO_PKG_VERSION"), comment(&scene.name));
+    let _ = writeln!(w, "# regenerate with `grainlab export liggghts SCENE --out DIR`.");
+    let writes = match info.analysis {
+        Analysis::Impact => "writes series.txt",
+        Analysis::Shear => "writes walls.txt",
+        Analysis::None => "records nothing",
+    };
+    let _ = writeln!(w, "# Run in this directory: liggghts -in in.liggghts (reads grains.data, {writes}).");
+    let _ = writeln!(w, "# Grains: spheres at z = 0 in a 3D box (the sphere-in-plane model); nothing moves them out of the plane.");
+    if model.lever_arm != LeverArm::RadiusMinusHalfOverlap && model.tangential != TangentialSpec::Frictionless {
+        let _ = writeln!(w, "{}", differs_line(Code::Liggghts, "model.lever_arm", name_of(&model.lever_arm)));
+    }
+    if model.tangential == TangentialSpec::IncrementalForce {
+        let _ = writeln!(w, "{}", differs_line(Code::Liggghts, "model.tangential", name_of(&model.tangential)));
+    }
+    if model.tangential == TangentialSpec::Frictionless {
+        let _ = writeln!(w, "# Frictionless: tangential history with coefficientFriction 0, so Ft = 0.");
+    }
+    let _ = writeln!(w, "atom_style granular\natom_modify map array");
+    let px = if e.boundary().is_periodic() { "p" } else { "f" };
+    let _ = writeln!(w, "boundary {px} f f\nnewton off\ncommunicate single vel yes\nunits si");
+    let _ = writeln!(w, "read_data grains.data");
+    let skin = scene.neighbor.skin * 2.0 * p.r[..p.n_free].iter().cloned().fold(f64::INFINITY, f64::min);
+    let _ = writeln!(w, "neighbor {} bin\nneigh_modify delay 0\nhard_particles yes", f(skin));
+    let list = |g: &dyn Fn(&crate::physics::material::Material) -> f64| mats.iter().map(|m| f(g(m))).collect::<Vec<_>>().join(" ");
+    let _ = writeln!(w, "fix m1 all property/global youngsModulus peratomtype {}", list(&|m| m.youngs_modulus));
+    let _ = writeln!(w, "fix m2 all property/global poissonsRatio peratomtype {}", list(&|m| m.poisson_ratio));
+    let pair = |g: &dyn Fn(&PairMaterial) -> f64| {
+        let mut v = Vec::new();
+        for a in mats {
+            for b in mats {
+                let pm = PairMaterial::mix(a, b);
+                v.push(f(g(&pm)));
+            }
+        }
+        v.join(" ")
+    };
+    let _ = writeln!(w, "fix m3 all property/global coefficientRestitution peratomtypepair {n} {}", pair(&|pm| pm.restitution));
+    let frictionless = model.tangential == TangentialSpec::Frictionless;
+    let _ = writeln!(w, "fix m4 all property/global coefficientFriction peratomtypepair {n} {}", pair(&|pm| if frictionless { 0.0 } else { pm.friction }));
+    let law = format!("model hertz tangential history{}", if model.limit_force { " limitForce on" } else { "" });
+    let _ = writeln!(w, "pair_style gran {law}\npair_coeff * *");
+    let _ = writeln!(w, "timestep {}", f(info.time_step_s));
+    let _ = writeln!(w, "group free id <> 1 {}", p.n_free);
+    let _ = writeln!(w, "run 0");
+    let mut wall_vars = Vec::new();
+    for wall in e.walls() {
+        let name = wall.name;
+        match &wall.surface {
+            Surface::Flat => {
+                let shear = if wall.v.x != 0.0 { format!(" shear x {}", f(wall.v.x)) } else { String::new() };
+                let _ = writeln!(w, "fix w_{name} free wall/gran {law} primitive type {} yplane {}{shear}", wall.material + 1 /* its material's atom type */, f(wall.y));
+            }
+            Surface::Rough { grains } => {
+                let (a, b) = (grains.start + 1, grains.end);
+                let _ = writeln!(w, "group {name} id <> {a} {b}");
+                match wall.control {
+                    Control::Fixed => {
+                        let _ = writeln!(w, "fix f_{name} {name} setforce 0.0 0.0 0.0");
+                        wall_vars.push((name, format!("f_f_{name}[1]"), format!("f_f_{name}[2]"), a));
+                    }
+                    Control::Load { force } => {
+                        // The row moves as its atoms: its mass is theirs (equal atoms, so
+                        // aveforce's equal forces keep it rigid).
+                        let atoms: f64 = grains.clone().map(|k| p.m[k]).sum();
+                        if (wall.mass - atoms).abs() > 1e-12 * atoms {
+                            return Err(refuse(Code::Liggghts, &format!("walls.{name}.mass"), wall.mass, &format!("the row's {} atoms weigh {atoms:e} kg", grains.len())));
+                        }
+                        let _ = writeln!(w, "fix f_{name} {name} setforce 0.0 NULL 0.0");
+                        let _ = writeln!(w, "# the load {} N on the row, per atom (aveforce adds its value to each atom)", f(force));
+                        let _ = writeln!(w, "fix l_{name} {name} aveforce NULL {} NULL", f(wall.load_y() / (b + 1 - a) as f64));
+                        wall_vars.push((name, format!("f_f_{name}[1]"), format!("f_l_{name}[2]"), a));
+                    }
+                }
+                let _ = writeln!(w, "fix i_{name} {name} nve");
+            }
+        }
+    }
+    let rotation = model.rotation && !frictionless;
+    let _ = writeln!(w, "fix integrate free {}", if rotation { "nve/sphere" } else { "nve" });
+    let _ = writeln!(w, "variable s equal step");
+    match if ex.bench { Analysis::None } else { info.analysis } {
+        Analysis::Impact => {
+            let mut cols = vec!["${s}".to_string()];
+            for k in 1..=p.n_free {
+                for (q, v) in [("x", "x"), ("y", "y"), ("vx", "vx"), ("vy", "vy"), ("wz", "omegaz"), ("fx", "fx"), ("fy", "fy")] {
+                    let _ = writeln!(w, "variable {q}{k} equal {v}[{k}]");
+                    cols.push(format!("${{{q}{k}}}"));
+                }
+            }
+            let _ = writeln!(w, "fix rec all print 1 \"{}\" file series.txt screen no title \"{}\"", cols.join(" "), info.columns.join(" "));
+        }
+        Analysis::Shear => {
+            let k = info.sample_every;
+            let (bot, top) = (&wall_vars[0], &wall_vars[1]);
+            let _ = writeln!(w, "variable gap equal y[{}]-y[{}]", top.3, bot.3);
+            let _ = writeln!(w, "fix avg all ave/time 1 {k} {k} {} {} {} {} v_gap", bot.1, bot.2, top.1, top.2);
+            let mut cols = vec!["${s}".to_string()];
+            for j in 1..=5 {
+                let _ = writeln!(w, "variable a{j} equal f_avg[{j}]");
+                cols.push(format!("${{a{j}}}"));
+            }
+            let _ = writeln!(w, "fix rec all print {k} \"{}\" file walls.txt screen no title \"{}\"", cols.join(" "), info.columns.join(" "));
+        }
+        Analysis::None => {
+            let _ = writeln!(w, "{}", if ex.bench { "# timing deck: nothing recorded" } else { "# analysis none: nothing recorded" });
+        }
+    }
+    let _ = writeln!(w, "thermo_style custom step atoms\nthermo {}", (info.steps / 10).max(1));
+    let _ = writeln!(w, "run {}", info.steps);
+    Ok(s)
+}
+
+/// The scene name in a deck comment: [`escaped`], and `&` escaped too. LIGGGHTS reads a
+/// line ending in `&` (spaces aside) as continued by the next one before it strips the
+/// `#` comment (LIGGGHTS-PUBLIC src/input.cpp, `Input::file`), so a comment ending in `&`
+/// would swallow the next command. `$` and quotes need nothing: the comment is stripped
+/// before variables are substituted, and a `#` outside quotes starts it.
+pub(crate) fn comment(s: &str) -> String {
+    escaped(s, &['&'])
+}
+
+/// The scene's JSON spelling of an enum value (`radius_minus_half_overlap`).
+pub(crate) fn name_of<T: serde::Serialize>(v: &T) -> String {
+    match serde_json::to_value(v) {
+        Ok(serde_json::Value::String(s)) => s,
+        other => format!("{other:?}"),
+    }
+}
+
