@@ -232,7 +232,8 @@ fn execute(cli: Cli) -> Result<(), Error> {
         }
         Command::Explain { scene } => {
             let scene = load_scene(&scene)?;
-            say!("{}", build_limited(&scene, 1, &limits)?.explain())
+            let built = build_limited(&scene, 1, &limits)?;
+            say!("{}\n{}", built.explain(), built.explain_effects().trim_end())
         }
         Command::Export { code, scene, out, overwrite, bench, explain_fields } => {
             if explain_fields {

@@ -24,13 +24,18 @@ fn scenes_lists_the_builtins_and_prints_one_that_runs_back() {
 }
 
 #[test]
-fn explain_prints_the_pipeline_in_one_line() {
+fn explain_prints_the_pipeline_in_one_line_then_every_effect() {
     grainlab()
         .args(["explain", "collision"])
         .assert()
         .success()
-        .stdout(predicate::str::contains("Contacts<Hertz, Viscoelastic, TotalDisplacementHistory>").and(predicate::str::contains("t_c/200")))
-        .stdout(predicate::function(|s: &str| s.trim().lines().count() == 1));
+        // The pipeline on the first line.
+        .stdout(predicate::function(|s: &str| s.lines().next().is_some_and(|l| l.contains("Contacts<Hertz, Viscoelastic, TotalDisplacementHistory>") && l.contains("t_c/200"))))
+        // Then one line per effect, on or off, with why: the ledger and the observers too.
+        .stdout(predicate::function(|s: &str| {
+            let on = |name: &str, state: &str| s.lines().any(|l| l.trim_start().starts_with(name) && l.contains(&format!(" {state} ")));
+            on("friction", "on") && on("energy ledger", "on") && on("impact observer", "on") && on("walls", "off") && on("gravity", "off") && on("ParaView frames", "off")
+        }));
 }
 
 #[test]

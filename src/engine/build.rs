@@ -2,6 +2,7 @@
 
 use crate::engine::consistency::{self, GrainNames, MAX_PACKING_OVERLAP, MAX_START_OVERLAP, MAX_STEP_MOVE};
 use crate::engine::domain::{Context, Domain};
+use crate::engine::effects::Effects;
 use crate::engine::integrate::{FinalIntegrate, InitialIntegrate};
 use crate::engine::neighbor::Neighbours;
 use crate::engine::simulation::{Engine, Simulation};
@@ -33,9 +34,16 @@ pub struct Built {
     pub depth: f64,
     /// Length of the periodic cell (or of the packing), m.
     pub length: f64,
+    /// Each effect on or off and why ([`Effects`]).
+    pub effects: Effects,
 }
 
 impl Built {
+    /// Every effect, on or off, why, and its measured cost ([`Effects::table`]).
+    pub fn explain_effects(&self) -> String {
+        self.effects.table(&crate::engine::effects::cost_runs(), &crate::engine::effects::this_cpu())
+    }
+
     /// The pipeline in one line, with dt and steps per contact.
     pub fn explain(&self) -> String {
         let ts = &self.time_step;
@@ -284,8 +292,11 @@ pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<B
         (ratio, format!("{} and {}", names.name(i, &p, &walls), names.name(j, &p, &walls)), release)
     });
 
+    // What the scene calls for, declared or derived from its values: an effect that is off
+    // has no stage and no kernel branch, and the time step does not allow for it.
+    let effects = Effects::of(scene, &p, &walls);
     // Time step from the smallest grain.
-    let friction = scene.model.tangential != TangentialSpec::Frictionless;
+    let friction = effects.friction;
     let imin = (0..n_free).min_by(|&a, &b| p.r[a].total_cmp(&p.r[b])).expect("at least one grain");
     let (r, m, i) = (p.r[imin], p.m[imin], p.inertia[imin]);
     let mat = &mats[p.material[imin] as usize];
@@ -316,7 +327,7 @@ pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<B
     limits.check(&estimate)?;
     consistency::motion(&p, &walls, Vec2::from(scene.gravity), &names, dt)?;
     consistency::load(scene, &p, &walls, length, depth, dt)?;
-    consistency::stable_for_every_pair(scene, &p, &walls, &time_step)?;
+    consistency::stable_for_every_pair(scene, &p, &walls, &time_step, friction)?;
     consistency::drag(scene, dt)?;
     consistency::impact(scene, &p, &walls, &boundary, scene.duration)?;
 
@@ -334,10 +345,12 @@ pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<B
         start_speed,
     };
     let options = ModelOptions { limit_force: scene.model.limit_force, lever_arm: scene.model.lever_arm };
-    let all_elastic = mats.iter().all(|m| m.restitution == 1.0);
+    let all_elastic = !effects.damping;
+    // Without friction (declared, or no pair that can touch has any) the frictionless law.
+    let tangential = if effects.friction { scene.model.tangential } else { TangentialSpec::Frictionless };
     let threads = crate::kernels::threads::Threads::new(threads)?;
     let parts = Parts { p, boundary, walls, dt, skin, scene, threads, domain, context };
-    let engine: Box<dyn Engine> = match (scene.model.tangential, all_elastic) {
+    let engine: Box<dyn Engine> = match (tangential, all_elastic) {
         (TangentialSpec::Frictionless, false) => parts.assemble(HertzFrictionless::new(options))?,
         (TangentialSpec::Frictionless, true) => parts.assemble(HertzFrictionlessElastic::new(options))?,
         (TangentialSpec::TotalDisplacement, false) => parts.assemble(LiggghtsHertzHistory::new(options))?,
@@ -345,7 +358,7 @@ pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<B
         (TangentialSpec::IncrementalForce, false) => parts.assemble(YadeMindlin::new(options))?,
         (TangentialSpec::IncrementalForce, true) => parts.assemble(YadeMindlinElastic::new(options))?,
     };
-    Ok(Built { engine, time_step, depth, length })
+    Ok(Built { engine, time_step, depth, length, effects })
 }
 
 /// The x extent of grains given as (x, r), m.

@@ -247,7 +247,8 @@ pub fn motion(p: &Particles, walls: &[Wall], gravity: Vec2, names: &GrainNames, 
 /// free grains' materials at the smallest radius, each free grain against a rough wall's
 /// glued grain, and against each flat wall, every grain of its own material's mass.
 /// Without `time_step.allow_unstable`, dt above the stiffest pair's limit is refused.
-pub fn stable_for_every_pair(scene: &Scene, p: &Particles, walls: &[Wall], info: &crate::engine::timestep::TimeStepInfo) -> Result<(), Error> {
+/// `friction`: a tangential force can arise ([`crate::engine::effects::Effects::friction`]).
+pub fn stable_for_every_pair(scene: &Scene, p: &Particles, walls: &[Wall], info: &crate::engine::timestep::TimeStepInfo, friction: bool) -> Result<(), Error> {
     use crate::engine::timestep::RefContact;
     if scene.time_step.allow_unstable {
         return Ok(());
@@ -290,7 +291,6 @@ pub fn stable_for_every_pair(scene: &Scene, p: &Particles, walls: &[Wall], info:
             }
         }
     }
-    let friction = scene.model.tangential != crate::scene::TangentialSpec::Frictionless;
     let v = info.characteristic_speed_m_s;
     let limit = |c: &RefContact| crate::engine::timestep::stability_limit(std::slice::from_ref(c), v, friction);
     let Some(k) = (0..refs.len()).min_by(|&x, &y| limit(&refs[x]).total_cmp(&limit(&refs[y]))) else { return Ok(()) };

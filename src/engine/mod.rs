@@ -11,6 +11,7 @@
 pub mod build;
 pub mod consistency;
 pub mod domain;
+pub mod effects;
 pub mod integrate;
 pub mod neighbor;
 #[cfg(feature = "parallel")]

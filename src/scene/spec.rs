@@ -355,6 +355,24 @@ impl SurfaceSpec {
             SurfaceSpec::Rough { radius } => radius,
         }
     }
+    /// `flat` or `rough`, as the scene file names it.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            SurfaceSpec::Flat => "flat",
+            SurfaceSpec::Rough { .. } => "rough",
+        }
+    }
+}
+
+impl Analysis {
+    /// As the scene file names it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Analysis::None => "none",
+            Analysis::Impact => "impact",
+            Analysis::Shear => "shear",
+        }
+    }
 }
 
 /// The measured quantity a tolerance applies to.
