@@ -83,7 +83,6 @@ struct Scratch {
     touching: Vec<u32>,
     sep: Vec<Vec2>,
     released: Vec<u32>,
-    pending: Vec<crate::physics::contact::EnergyTerms>,
     /// Largest overlap ratio of the part and its pair index.
     worst: (f64, usize),
     /// What the thread's cross pairs did this step, in slot order.
@@ -414,7 +413,7 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN: bool> Stage<Con
                 let start = Instant::now();
                 let mut waited = Duration::ZERO;
                 let (g0, part) = (bounds[r], pb[r]..pb[r + 1]);
-                let Scratch { touching, sep, released, pending, worst, cross_out, wall_out, busy } = sc;
+                let Scratch { touching, sep, released, worst, cross_out, wall_out, busy } = sc;
                 // If this thread panics before it publishes, the others must not wait for it.
                 let _guard = (Publish(&published[r]), Publish(&published_walls[r]));
                 let mut none = EnergyLedger::default();
@@ -435,7 +434,7 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN: bool> Stage<Con
                         }
                         cross_out[slot] = o;
                     };
-                    compute_pairs::<Dm, T, ENERGY, SPIN>(&view, list, &touching[..nt], &sep[..nt], &released[..nr], ledgers.reborrow(), sink, pending);
+                    compute_pairs::<Dm, T, ENERGY, SPIN>(&view, list, &touching[..nt], &sep[..nt], &released[..nr], ledgers.reborrow(), sink);
                 }
                 let own_cross: &[PairOut] = cross_out;
                 let _ = published[r].set(own_cross);
@@ -478,7 +477,7 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN: bool> Stage<Con
                     }
                 };
                 let sink = |_, ij: (usize, usize), o: PairOut| add(ij, &o, true);
-                let (ratio, kk) = compute_pairs::<Dm, T, ENERGY, SPIN>(&view, list, &touching[..nt], &sep[..nt], &released[..nr], ledgers, sink, pending);
+                let (ratio, kk) = compute_pairs::<Dm, T, ENERGY, SPIN>(&view, list, &touching[..nt], &sep[..nt], &released[..nr], ledgers, sink);
                 let mut best = if kk == usize::MAX { (0.0, usize::MAX) } else { (ratio, part.start + kk) };
                 // (5) Our cross pairs' forces on our grains: a grain's pairs (g, j) with j in
                 // a later range are the last of its sequence.

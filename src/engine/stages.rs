@@ -11,7 +11,7 @@ use crate::kernels::driver::{Ledgers, PairOut, PairSlices, PairView, compute_pai
 use crate::kernels::sweep::sort_pairs;
 use crate::physics::contact::damping::Damping;
 use crate::physics::contact::tangential::Tangential;
-use crate::physics::contact::{ContactInput, ContactLaw, ContactModel, EnergyTerms};
+use crate::physics::contact::{ContactInput, ContactLaw, ContactModel};
 use crate::physics::dim::{Vec2, cross};
 use crate::physics::walls::{Control, Surface};
 
@@ -159,7 +159,6 @@ pub struct PairForces<const ENERGY: bool, const SPIN: bool> {
     touching: Vec<u32>,
     sep: Vec<Vec2>,
     released: Vec<u32>,
-    pending: Vec<EnergyTerms>,
 }
 
 impl<Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN: bool> Stage<ContactModel<Dm, T>> for PairForces<ENERGY, SPIN> {
@@ -186,7 +185,7 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN: bool> Stage<Con
                 ts[j] -= o.torque[1];
             }
         };
-        let (ratio, k) = compute_pairs::<Dm, T, ENERGY, SPIN>(&view, list, touching, sep, released, Ledgers::One(&mut w.ledger), sink, &mut self.pending);
+        let (ratio, k) = compute_pairs::<Dm, T, ENERGY, SPIN>(&view, list, touching, sep, released, Ledgers::One(&mut w.ledger), sink);
         if ratio > worst.0 {
             let [i, j] = pairs.pairs()[k];
             worst = (ratio, i as usize, j as usize);

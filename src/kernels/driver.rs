@@ -91,7 +91,7 @@ pub fn pair_contact<Dm: Damping, T: Tangential, const ENERGY: bool>(
 /// Four touching pairs at once, one per SIMD lane (`ks`: their indices in the list, `ds`
 /// their separations): the same bits as [`one_pair`] gives each of them, handed to
 /// `sink` (index in the part, grains, output) in lane order; with `ENERGY`, their energy
-/// terms (also in lanes, their energy memories moved on) go to `pending`. Without `SPIN`
+/// terms (also in lanes, their energy memories moved on) go to `terms`. Without `SPIN`
 /// (grains that do not rotate) the spins are not read and the torques not computed.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
@@ -102,7 +102,7 @@ fn four_pairs<Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN: bool>(
     ks: &[u32],
     ds: &[Vec2],
     sink: &mut impl FnMut(usize, (usize, usize), PairOut),
-    pending: &mut [EnergyTerms],
+    terms_out: &mut [EnergyTerms; LANES],
     best: &mut (f64, usize),
 ) {
     let (model, p) = (w.law, w.p);
@@ -172,7 +172,7 @@ fn four_pairs<Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN: bool>(
         active[ks[l]] = true;
         sink(ks[l], ij[l], PairOut { force: lane2(&c.force, l), torque: [torque[0].extract(l), torque[1].extract(l)], ratio: ratio.extract(l) });
         if ENERGY {
-            pending[l] = terms.lane(l);
+            terms_out[l] = terms.lane(l);
         }
     }
 }
@@ -232,23 +232,18 @@ impl Ledgers<'_> {
             Ledgers::PerPair(v) => Ledgers::PerPair(v),
         }
     }
-    #[inline(always)]
-    fn get(&mut self, k: usize) -> &mut EnergyLedger {
-        match self {
-            Ledgers::One(l) => l,
-            Ledgers::PerPair(v) => &mut v[k],
-        }
-    }
 }
 
 /// Compute the pairs `touching` and `released` of a list part (indices from
-/// [`crate::kernels::sweep::sort_pairs`]): the output of each touching pair goes to `sink` (its index in the
-/// part, its grains and its output), in list order. The touching pairs run four at a
-/// time in SIMD lanes, their energy terms too (with the energy ledger); the ledger then
-/// adds those and the released pairs' in list order, so that it sums in the serial
-/// order; `pending` holds the terms meanwhile. Returns the largest overlap over the
-/// smaller radius of the touching pairs and the index (in the part) of the first pair
-/// that has it, `(0, usize::MAX)` if none touches.
+/// [`crate::kernels::sweep::sort_pairs`]): the output of each touching pair goes to `sink`
+/// (its index in the part, its grains and its output), in list order. The touching pairs
+/// run four at a time in SIMD lanes, their energy terms too (with the energy ledger).
+/// The ledger takes each four's terms as soon as they are computed, lane by lane, with
+/// the released pairs that come before each in the list closed in between: every term
+/// is added in list order, so the sums are those of one pair at a time. (One ledger is
+/// summed in a local copy, which the compiler can keep in registers.) Returns the
+/// largest overlap over the smaller radius of the touching pairs and the index (in the
+/// part) of the first pair that has it, `(0, usize::MAX)` if none touches.
 #[allow(clippy::too_many_arguments)]
 pub fn compute_pairs<Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN: bool>(
     w: &PairView<'_, ContactModel<Dm, T>>,
@@ -258,20 +253,46 @@ pub fn compute_pairs<Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN:
     released: &[u32],
     mut ledgers: Ledgers<'_>,
     mut sink: impl FnMut(usize, (usize, usize), PairOut),
-    pending: &mut Vec<EnergyTerms>,
 ) -> (f64, usize) {
     let mut best = (0.0, usize::MAX);
-    if ENERGY && pending.len() < touching.len() {
-        pending.resize(touching.len(), EnergyTerms::default());
-    }
     let quads = touching.len() / LANES * LANES;
     // One material: its lanes once, not a table lookup per lane.
     let single = w.pair_table.single().map(|m| PairMaterial::gather([m; LANES]));
     let PairSlices { pairs, consts, hist, energy, active } = list;
-    let mut pend = pending.chunks_exact_mut(LANES);
+    let mut acc = match &ledgers {
+        Ledgers::One(l) => **l,
+        Ledgers::PerPair(_) => EnergyLedger::default(),
+    };
+    // The ledger of pair k: the local sum, or the pair's own.
+    macro_rules! ledger {
+        ($k:expr) => {
+            match &mut ledgers {
+                Ledgers::One(_) => &mut acc,
+                Ledgers::PerPair(v) => &mut v[$k],
+            }
+        };
+    }
+    // Close the released pairs listed before pair `limit` (with the ledger).
+    let mut next_released = 0;
+    macro_rules! release_before {
+        ($limit:expr) => {
+            while next_released < released.len() && (released[next_released] as usize) < $limit {
+                let k = released[next_released] as usize;
+                pair_contact::<Dm, T, true>(w, pairs.pairs()[k], &consts[k], &mut hist[k], &mut energy[k], &mut active[k], ledger!(k));
+                next_released += 1;
+            }
+        };
+    }
+    let mut terms = [EnergyTerms::default(); LANES];
     for (ks, ds) in touching[..quads].chunks_exact(LANES).zip(sep.chunks_exact(LANES)) {
         let slices = PairSlices::<T> { pairs, consts, hist: &mut *hist, energy: &mut *energy, active: &mut *active };
-        four_pairs::<Dm, T, ENERGY, SPIN>(w, slices, single.as_ref(), ks, ds, &mut sink, if ENERGY { pend.next().expect("a slot per pair") } else { &mut [] }, &mut best);
+        four_pairs::<Dm, T, ENERGY, SPIN>(w, slices, single.as_ref(), ks, ds, &mut sink, &mut terms, &mut best);
+        if ENERGY {
+            for (t, &k) in terms.iter().zip(ks) {
+                release_before!(k as usize);
+                w.law.add_terms(t, ledger!(k as usize));
+            }
+        }
     }
     for (m, &k) in touching.iter().enumerate().skip(quads) {
         let k = k as usize;
@@ -282,29 +303,22 @@ pub fn compute_pairs<Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN:
         }
         sink(k, (i, j), o);
         if ENERGY {
-            pending[m] = w.law.energy_terms(p.n, p.dn, w.dt, &p.state, &mut energy[k]);
+            let t = w.law.energy_terms(p.n, p.dn, w.dt, &p.state, &mut energy[k]);
+            release_before!(k);
+            w.law.add_terms(&t, ledger!(k));
         }
     }
-    let mut none = EnergyLedger::default();
     if !ENERGY {
+        let mut none = EnergyLedger::default();
         for &k in released {
             let k = k as usize;
             pair_contact::<Dm, T, false>(w, pairs.pairs()[k], &consts[k], &mut hist[k], &mut EnergyMemory::default(), &mut active[k], &mut none);
         }
         return best;
     }
-    // Both kinds merged in list order: the ledger is a sum.
-    let (mut a, mut b) = (0, 0);
-    while a < touching.len() || b < released.len() {
-        if b == released.len() || (a < touching.len() && touching[a] < released[b]) {
-            let k = touching[a] as usize;
-            w.law.add_terms(&pending[a], ledgers.get(k));
-            a += 1;
-        } else {
-            let k = released[b] as usize;
-            pair_contact::<Dm, T, true>(w, pairs.pairs()[k], &consts[k], &mut hist[k], &mut energy[k], &mut active[k], ledgers.get(k));
-            b += 1;
-        }
+    release_before!(usize::MAX);
+    if let Ledgers::One(l) = ledgers {
+        *l = acc;
     }
     best
 }
