@@ -114,18 +114,26 @@ fn lanes_match_alone<T: grainlab::physics::contact::tangential::Tangential>(
         prop_assert_eq!(s.normal.extract(l).to_bits(), alone[l].0.normal.to_bits());
         prop_assert_eq!(bits(&T::lane(&h, l)), bits(&alone[l].1), "lane {} history", l);
     }
-    // The energy terms, from a made-up previous step, likewise.
-    use grainlab::physics::contact::{EnergyMemory, EnergyTerms};
-    let memory = |c: &[f64; 9]| EnergyMemory { fd_prev: c[2], fte_prev: Vec2::new(c[5], c[6]) * 1e3, ftd_prev: Vec2::new(c[3], c[4]), ut_prev: 1e-9 * c[8] };
-    let term_bits = |t: &EnergyTerms| [t.normal_damping, t.elastic_normal, t.tangential_damping, t.friction, t.tangential_model, t.elastic_tangential].map(f64::to_bits);
-    let mem_bits = |m: &EnergyMemory| [m.fd_prev, m.fte_prev.x, m.fte_prev.y, m.ftd_prev.x, m.ftd_prev.y, m.ut_prev].map(f64::to_bits);
+    // The energy memory (previous values and sums), from a made-up previous step,
+    // likewise.
+    use grainlab::physics::contact::EnergyMemory;
+    use grainlab::physics::energy::EnergySums;
+    let memory = |c: &[f64; 9]| EnergyMemory {
+        fd_prev: c[2],
+        fte_prev: Vec2::new(c[5], c[6]) * 1e3,
+        ftd_prev: Vec2::new(c[3], c[4]),
+        sums: EnergySums { normal_damping: 1e-9 * c[8], tangential_damping: 1e-9 * c[7], friction: 1e-9 * c[0].abs(), tangential_model: 1e-9 * c[1] },
+    };
+    let mem_bits = |m: &EnergyMemory| {
+        let s = &m.sums;
+        [m.fd_prev, m.fte_prev.x, m.fte_prev.y, m.ftd_prev.x, m.ftd_prev.y, s.normal_damping, s.tangential_damping, s.friction, s.tangential_model].map(f64::to_bits)
+    };
     let mems: Vec<_> = cs.iter().map(memory).collect();
-    let mut m = EnergyMemory::gather([&mems[0], &mems[1], &mems[2], &mems[3]]);
-    let t = model.energy_terms(lanes.n, lanes.dn, lanes.dt, &s, &mut m);
+    let mut m = EnergyMemory::gather([&mems[0], &mems[1], &mems[2], &mems[3]], true);
+    model.energy_step(lanes.n, lanes.dt, &s, &mut m);
     for l in 0..4 {
         let mut alone_m = mems[l];
-        let alone_t = model.energy_terms(one[l].n, one[l].dn, one[l].dt, &alone[l].0, &mut alone_m);
-        prop_assert_eq!(term_bits(&t.lane(l)), term_bits(&alone_t), "lane {} energy terms", l);
+        model.energy_step(one[l].n, one[l].dt, &alone[l].0, &mut alone_m);
         prop_assert_eq!(mem_bits(&m.lane(l)), mem_bits(&alone_m), "lane {} energy memory", l);
     }
     Ok(())

@@ -26,8 +26,9 @@
 //! keeping it, for a wall's grain on a thread after the first), (5) adds its own cross
 //! pairs to their first grains: a grain's pairs (g, j) with j in a later range have the
 //! largest j, so they are the last of its sequence, and publishes what it kept for the
-//! walls' grains; (6) the first thread adds those, range by range. Then the energy terms
-//! are merged in list order and the largest overlap picked as the serial loop would.
+//! walls' grains; (6) the first thread adds those, range by range. Then the largest
+//! overlap is picked as the serial loop would. Each pair adds its energy terms to its own
+//! sums, which the ledger adds in list order when it takes them: no order to restore.
 //! `tests/parallel.rs` checks identical bits with 1, 2 and 3 threads.
 //!
 //! Were the walls' grains the last thread's (as in the per-grain stages), the other
@@ -38,14 +39,13 @@
 
 use crate::engine::world::{Stage, World};
 use crate::error::Error;
-use crate::kernels::driver::{Ledgers, PairOut, PairSlices, PairView, compute_pairs};
+use crate::kernels::driver::{PairOut, PairSlices, PairView, compute_pairs};
 use crate::kernels::sweep::sort_pairs;
 use crate::kernels::threads::Threads;
 use crate::physics::contact::ContactModel;
 use crate::physics::contact::damping::Damping;
 use crate::physics::contact::tangential::Tangential;
 use crate::physics::dim::Vec2;
-use crate::physics::energy::EnergyLedger;
 use std::sync::OnceLock;
 use std::time::{Duration, Instant};
 
@@ -174,8 +174,6 @@ pub struct ParallelPairForces<const ENERGY: bool, const SPIN: bool> {
     cross_bounds: Vec<usize>,
     /// For each range, the slots of the cross pairs whose second grain is in it, in list order.
     incoming: Vec<Vec<u32>>,
-    /// Energy terms of every pair, merged in list order (with the energy ledger only).
-    ledgers: Vec<EnergyLedger>,
     scratch: Vec<Scratch>,
     /// Neighbour-list build the tables belong to.
     built_for: u64,
@@ -192,7 +190,7 @@ pub struct ParallelPairForces<const ENERGY: bool, const SPIN: bool> {
 /// alone, and a short run may not see a second list.
 const FIRST_TIMING: usize = 100;
 
-/// Where to cut the per-pair ledgers and energy memories for list parts cut at `bounds`:
+/// Where to cut the per-pair energy memories for list parts cut at `bounds`:
 /// the same places with the energy ledger, else nowhere (they are empty).
 fn energy_cuts<const ENERGY: bool>(bounds: &[usize]) -> Vec<usize> {
     if ENERGY { bounds.to_vec() } else { vec![0; bounds.len()] }
@@ -298,7 +296,6 @@ impl<const ENERGY: bool, const SPIN: bool> ParallelPairForces<ENERGY, SPIN> {
             cross_in_part: Vec::new(),
             cross_bounds: Vec::new(),
             incoming: Vec::new(),
-            ledgers: Vec::new(),
             scratch: (0..t).map(|_| Scratch::default()).collect(),
             built_for: u64::MAX,
             shares: vec![1.0 / t as f64; t],
@@ -379,9 +376,7 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN: bool> Stage<Con
             self.tables(n, n_free, &w.pairs.pairs, &w.pairs.active);
             self.built_for = w.neighbours.builds;
         }
-        self.ledgers.clear();
-        self.ledgers.resize(if ENERGY { np } else { 0 }, EnergyLedger::default());
-        let ledger_bounds = energy_cuts::<ENERGY>(&self.pair_bounds);
+        let energy_bounds = energy_cuts::<ENERGY>(&self.pair_bounds);
         let mut f = std::mem::take(&mut w.p.f);
         let mut torque = std::mem::take(&mut w.p.torque);
         let view = PairView { p: &w.p, boundary: w.boundary, law: w.law, pair_table: &w.pair_table, dt: w.dt };
@@ -404,20 +399,18 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN: bool> Stage<Con
             let parts = cut(&mut w.pairs.hist, pb)
                 .into_iter()
                 .zip(cut(&mut w.pairs.active, pb))
-                .zip(cut(&mut self.ledgers, &ledger_bounds).into_iter().zip(cut(&mut w.pairs.energy, &ledger_bounds)))
+                .zip(cut(&mut w.pairs.energy, &energy_bounds))
                 .zip(f_parts.into_iter().zip(torque_parts))
                 .zip(self.scratch.iter_mut())
                 .enumerate()
                 .map(|(r, p)| (p, if r == 0 { walls.take() } else { None }));
-            threads.each(parts.collect(), |r, (((((hist, active), (ledgers, energy)), (fl, tl)), sc), mut walls)| {
+            threads.each(parts.collect(), |r, (((((hist, active), energy), (fl, tl)), sc), mut walls)| {
                 let start = Instant::now();
                 let mut waited = Duration::ZERO;
                 let (g0, part) = (bounds[r], pb[r]..pb[r + 1]);
                 let Scratch { touching, sep, released, worst, cross_out, wall_out, busy } = sc;
                 // If this thread panics before it publishes, the others must not wait for it.
                 let _guard = (Publish(&published[r]), Publish(&published_walls[r]));
-                let mut none = EnergyLedger::default();
-                let mut ledgers = if ENERGY { Ledgers::PerPair(ledgers) } else { Ledgers::One(&mut none) };
                 // (1) Our cross pairs first, as the serial stage does its pairs: sort out the
                 // touching and released ones, then the touching ones four at a time.
                 let slots = &cross[cb[r]..cb[r + 1]];
@@ -434,7 +427,7 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN: bool> Stage<Con
                         }
                         cross_out[slot] = o;
                     };
-                    compute_pairs::<Dm, T, ENERGY, SPIN>(&view, list, &touching[..nt], &sep[..nt], &released[..nr], ledgers.reborrow(), sink);
+                    compute_pairs::<Dm, T, ENERGY, SPIN>(&view, list, &touching[..nt], &sep[..nt], &released[..nr], sink);
                 }
                 let own_cross: &[PairOut] = cross_out;
                 let _ = published[r].set(own_cross);
@@ -477,7 +470,7 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN: bool> Stage<Con
                     }
                 };
                 let sink = |_, ij: (usize, usize), o: PairOut| add(ij, &o, true);
-                let (ratio, kk) = compute_pairs::<Dm, T, ENERGY, SPIN>(&view, list, &touching[..nt], &sep[..nt], &released[..nr], ledgers, sink);
+                let (ratio, kk) = compute_pairs::<Dm, T, ENERGY, SPIN>(&view, list, &touching[..nt], &sep[..nt], &released[..nr], sink);
                 let mut best = if kk == usize::MAX { (0.0, usize::MAX) } else { (ratio, part.start + kk) };
                 // (5) Our cross pairs' forces on our grains: a grain's pairs (g, j) with j in
                 // a later range are the last of its sequence.
@@ -506,8 +499,8 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN: bool> Stage<Con
         }
         w.p.f = f;
         w.p.torque = torque;
-        // (3) The largest overlap as the serial loop picks it (the first of equal maxima),
-        // and the energy terms in list order.
+        // The largest overlap as the serial loop picks it (the first of equal maxima). (The
+        // energy terms are in each pair's sums: no order to restore.)
         let mut best = (0.0, usize::MAX);
         for &(ratio, k) in self.scratch.iter().map(|s| &s.worst) {
             if k != usize::MAX && (ratio > best.0 || (ratio == best.0 && k < best.1)) {
@@ -517,17 +510,6 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN: bool> Stage<Con
         if best.1 != usize::MAX && best.0 > w.max_overlap.0 {
             let p = w.pairs.pairs[best.1];
             w.max_overlap = (best.0, p[0] as usize, p[1] as usize);
-        }
-        if ENERGY {
-            let g = &mut w.ledger;
-            for l in &self.ledgers {
-                g.normal_damping += l.normal_damping;
-                g.tangential_damping += l.tangential_damping;
-                g.friction += l.friction;
-                g.tangential_model += l.tangential_model;
-                g.elastic_normal += l.elastic_normal;
-                g.elastic_tangential += l.elastic_tangential;
-            }
         }
         Ok(())
     }

@@ -31,7 +31,8 @@ impl<L: ContactLaw> Simulation<L> {
         }
         world.dt = dt;
         let (a, b, c) = world.kinetic();
-        world.initial_energy = a + b + c + world.ledger.elastic_normal + world.ledger.elastic_tangential;
+        let stored = world.ledger_now();
+        world.initial_energy = a + b + c + stored.elastic_normal + stored.elastic_tangential;
         let timers = vec![Duration::ZERO; stages.len()];
         Ok(Simulation { world, stages, timers })
     }

@@ -7,7 +7,7 @@
 
 use crate::engine::world::World;
 use crate::error::Error;
-use crate::kernels::driver::{Ledgers, PairOut, PairSlices, PairView, compute_pairs};
+use crate::kernels::driver::{PairOut, PairSlices, PairView, compute_pairs};
 use crate::kernels::sweep::sort_pairs;
 use crate::physics::contact::damping::Damping;
 use crate::physics::contact::tangential::Tangential;
@@ -40,7 +40,8 @@ impl<L: ContactLaw> Stage<L> for MoveWalls {
     }
 }
 
-/// Rebuild the Verlet list when a grain has moved more than half the skin.
+/// Rebuild the Verlet list when a grain has moved more than half the skin (the pairs'
+/// energy sums go into the ledger first, in list order: the new list starts them at 0).
 pub struct UpdateNeighbours;
 
 impl<L: ContactLaw> Stage<L> for UpdateNeighbours {
@@ -53,6 +54,9 @@ impl<L: ContactLaw> Stage<L> for UpdateNeighbours {
             // rebuild passes over all grains anyway.
             w.check_domain()?;
             let pairs = w.neighbours.build(&w.p.x, &w.p.r, w.p.n_free, &w.boundary, &w.threads);
+            if w.pairs.keep_energy {
+                w.ledger.add(&w.pairs.energy_sums());
+            }
             w.pairs.replace(pairs, &w.p.r, &w.p.m, &w.threads);
         }
         Ok(())
@@ -185,7 +189,7 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN: bool> Stage<Con
                 ts[j] -= o.torque[1];
             }
         };
-        let (ratio, k) = compute_pairs::<Dm, T, ENERGY, SPIN>(&view, list, touching, sep, released, Ledgers::One(&mut w.ledger), sink);
+        let (ratio, k) = compute_pairs::<Dm, T, ENERGY, SPIN>(&view, list, touching, sep, released, sink);
         if ratio > worst.0 {
             let [i, j] = pairs.pairs()[k];
             worst = (ratio, i as usize, j as usize);
@@ -225,7 +229,10 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
                     if active[i] {
                         let spin = if T::FRICTION { ri * p.omega[i] } else { 0.0 };
                         let vc = p.v[i] - wall.v + spin * Vec2::new(n.y, -n.x);
-                        model.release::<ENERGY>(vc, n, dt, &mut h.tangential, &mut h.energy, &mut w.ledger);
+                        model.release::<ENERGY>(vc, n, dt, &mut h.tangential, &mut h.energy);
+                        if ENERGY {
+                            w.ledger.add(&std::mem::take(&mut h.energy.sums));
+                        }
                         active[i] = false;
                     }
                     continue;

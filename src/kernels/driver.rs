@@ -1,7 +1,7 @@
 //! The contact kernel driver: each touching pair's input gathered from the grains'
 //! slices, the contact law run one pair or four in SIMD lanes with the same bits, each
-//! pair's force and torque handed to a sink in list order, the energy terms summed in
-//! the serial order. It reads a view of the grains ([`PairView`]) and the list's slices
+//! pair's force and torque handed to a sink in list order, each pair's energy terms
+//! added to its own sums (no order between pairs to keep). It reads a view of the grains ([`PairView`]) and the list's slices
 //! ([`PairSlices`]): no World, no Engine. Uses physics and the pair list.
 
 use nalgebra::Vector2;
@@ -10,9 +10,9 @@ use crate::kernels::pairs::{CheckedPairs, PairConst};
 use crate::physics::boundary::Boundary;
 use crate::physics::contact::damping::Damping;
 use crate::physics::contact::tangential::Tangential;
-use crate::physics::contact::{ContactInput, ContactLaw, ContactModel, EnergyMemory, EnergyTerms, LeverArm};
+use crate::physics::contact::model::ContactState;
+use crate::physics::contact::{ContactInput, ContactLaw, ContactModel, EnergyMemory, LeverArm};
 use crate::physics::dim::{Vec2, cross};
-use crate::physics::energy::EnergyLedger;
 use crate::physics::lanes::{LANES, Lanes, Real, gather, gather2, lane2};
 use crate::physics::material::PairMaterial;
 use crate::physics::particles::Particles;
@@ -51,10 +51,9 @@ fn pair_torque<R: Real>(lever: LeverArm, c: &ContactInput<R>, ft: Vector2<R>, ri
 }
 
 /// One pair of the Verlet list: the contact force (touching), the end of a contact
-/// (released), or nothing; tangential state `h`, energy memory `e` (with `ENERGY`) and
-/// energy terms updated.
+/// (released), or nothing; tangential state `h` and (with `ENERGY`) energy memory `e`
+/// updated.
 #[inline(always)]
-#[allow(clippy::too_many_arguments)]
 pub fn pair_contact<Dm: Damping, T: Tangential, const ENERGY: bool>(
     w: &PairView<'_, ContactModel<Dm, T>>,
     pair: [u32; 2],
@@ -62,7 +61,6 @@ pub fn pair_contact<Dm: Damping, T: Tangential, const ENERGY: bool>(
     h: &mut T::History<f64>,
     e: &mut EnergyMemory,
     active: &mut bool,
-    ledger: &mut EnergyLedger,
 ) -> PairOut {
     let model = w.law;
     let p = w.p;
@@ -76,14 +74,14 @@ pub fn pair_contact<Dm: Damping, T: Tangential, const ENERGY: bool>(
             let n = d / rsq.sqrt();
             let spin = if T::FRICTION { ri * p.omega[i] + rj * p.omega[j] } else { 0.0 };
             let vc = p.v[i] - p.v[j] + spin * Vec2::new(n.y, -n.x);
-            model.release::<ENERGY>(vc, n, w.dt, h, e, ledger);
+            model.release::<ENERGY>(vc, n, w.dt, h, e);
             *active = false;
         }
         return PairOut::default();
     }
-    let (o, pend) = one_pair::<Dm, T, true>(w, (i, j), d, pc, h, active);
+    let (o, n, state) = one_pair::<Dm, T, true>(w, (i, j), d, pc, h, active);
     if ENERGY {
-        model.account(pend.n, pend.dn, w.dt, &pend.state, e, ledger);
+        model.energy_step(n, w.dt, &state, e);
     }
     o
 }
@@ -91,7 +89,7 @@ pub fn pair_contact<Dm: Damping, T: Tangential, const ENERGY: bool>(
 /// Four touching pairs at once, one per SIMD lane (`ks`: their indices in the list, `ds`
 /// their separations): the same bits as [`one_pair`] gives each of them, handed to
 /// `sink` (index in the part, grains, output) in lane order; with `ENERGY`, their energy
-/// terms (also in lanes, their energy memories moved on) go to `terms`. Without `SPIN`
+/// memories move on (in lanes too). Without `SPIN`
 /// (grains that do not rotate) the spins are not read and the torques not computed.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
@@ -102,7 +100,6 @@ fn four_pairs<Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN: bool>(
     ks: &[u32],
     ds: &[Vec2],
     sink: &mut impl FnMut(usize, (usize, usize), PairOut),
-    terms_out: &mut [EnergyTerms; LANES],
     best: &mut (f64, usize),
 ) {
     let (model, p) = (w.law, w.p);
@@ -155,30 +152,24 @@ fn four_pairs<Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN: bool>(
             }
         }
     }
-    // With the ledger, the energy terms too, in lanes; the ledger adds them later in
-    // list order.
-    let terms = if ENERGY {
-        let mut e = EnergyMemory::gather(std::array::from_fn(|l| &list.energy[ks[l]]));
-        let t = model.energy_terms(input.n, input.dn, input.dt, &c, &mut e);
+    // With the ledger, the energy memories too, in lanes.
+    if ENERGY {
+        let mut e = EnergyMemory::gather(std::array::from_fn(|l| &list.energy[ks[l]]), T::FRICTION);
+        model.energy_step(input.n, input.dt, &c, &mut e);
         for (l, &k) in ks.iter().enumerate() {
-            list.energy[k] = e.lane(l);
+            e.store_lane(l, &mut list.energy[k], T::FRICTION);
         }
-        t
-    } else {
-        EnergyTerms::default()
-    };
+    }
     for l in 0..LANES {
         hist[ks[l]] = T::lane(&h, l);
         active[ks[l]] = true;
         sink(ks[l], ij[l], PairOut { force: lane2(&c.force, l), torque: [torque[0].extract(l), torque[1].extract(l)], ratio: ratio.extract(l) });
-        if ENERGY {
-            terms_out[l] = terms.lane(l);
-        }
     }
 }
 
 /// One touching pair of grains `(i, j)` at separation `d` (minimum image, i minus j):
-/// its force, advancing its tangential state `h`, and what its energy accounting needs.
+/// its output, advancing its tangential state `h`, and what its energy accounting needs
+/// (the normal and the step's contact state).
 #[inline(always)]
 fn one_pair<Dm: Damping, T: Tangential, const SPIN: bool>(
     w: &PairView<'_, ContactModel<Dm, T>>,
@@ -187,7 +178,7 @@ fn one_pair<Dm: Damping, T: Tangential, const SPIN: bool>(
     pc: &PairConst,
     h: &mut T::History<f64>,
     active: &mut bool,
-) -> (PairOut, Touch) {
+) -> (PairOut, Vec2, ContactState) {
     let (model, p) = (w.law, w.p);
     let lever = model.options.lever_arm;
     let input = pair_input::<f64, T, SPIN>(lever, d, p.r[i], p.r[j], p.omega[i], p.omega[j], p.v[i] - p.v[j], pc.r_star, pc.sqrt_m_star, w.dt);
@@ -195,16 +186,7 @@ fn one_pair<Dm: Damping, T: Tangential, const SPIN: bool>(
     let c = model.force(&input, pm, h);
     *active = true;
     let torque = if T::FRICTION && SPIN { pair_torque(lever, &input, c.tangential.elastic + c.tangential.damping, p.r[i], p.r[j]) } else { [0.0, 0.0] };
-    (PairOut { force: c.force, torque, ratio: input.dn * pc.inv_r_min }, Touch { n: input.n, dn: input.dn, state: c })
-}
-
-/// What a touching pair's energy accounting needs: the normal, the overlap (m), and the
-/// step's contact state.
-#[derive(Clone, Copy, Debug, Default)]
-struct Touch {
-    n: Vec2,
-    dn: f64,
-    state: crate::physics::contact::model::ContactState,
+    (PairOut { force: c.force, torque, ratio: input.dn * pc.inv_r_min }, input.n, c)
 }
 
 /// A part of the pair list: the pairs, their constants, tangential states, energy
@@ -217,41 +199,20 @@ pub struct PairSlices<'a, T: Tangential> {
     pub active: &'a mut [bool],
 }
 
-/// Where the energy terms of the pairs go: the world's ledger (serial order), or one
-/// ledger per pair of the list part (merged in list order later).
-pub enum Ledgers<'a> {
-    One(&'a mut EnergyLedger),
-    PerPair(&'a mut [EnergyLedger]),
-}
-
-impl Ledgers<'_> {
-    /// The same ledgers, for a shorter while.
-    pub fn reborrow(&mut self) -> Ledgers<'_> {
-        match self {
-            Ledgers::One(l) => Ledgers::One(l),
-            Ledgers::PerPair(v) => Ledgers::PerPair(v),
-        }
-    }
-}
-
 /// Compute the pairs `touching` and `released` of a list part (indices from
 /// [`crate::kernels::sweep::sort_pairs`]): the output of each touching pair goes to `sink`
 /// (its index in the part, its grains and its output), in list order. The touching pairs
-/// run four at a time in SIMD lanes, their energy terms too (with the energy ledger).
-/// The ledger takes each four's terms as soon as they are computed, lane by lane, with
-/// the released pairs that come before each in the list closed in between: every term
-/// is added in list order, so the sums are those of one pair at a time. (One ledger is
-/// summed in a local copy, which the compiler can keep in registers.) Returns the
-/// largest overlap over the smaller radius of the touching pairs and the index (in the
-/// part) of the first pair that has it, `(0, usize::MAX)` if none touches.
-#[allow(clippy::too_many_arguments)]
+/// run four at a time in SIMD lanes, their energy memories too (with the energy ledger);
+/// each pair adds its energy terms to its own sums, so the pairs need no order among
+/// them for the ledger. Returns the largest overlap over the smaller radius of the
+/// touching pairs and the index (in the part) of the first pair that has it,
+/// `(0, usize::MAX)` if none touches.
 pub fn compute_pairs<Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN: bool>(
     w: &PairView<'_, ContactModel<Dm, T>>,
     list: PairSlices<'_, T>,
     touching: &[u32],
     sep: &[Vec2],
     released: &[u32],
-    mut ledgers: Ledgers<'_>,
     mut sink: impl FnMut(usize, (usize, usize), PairOut),
 ) -> (f64, usize) {
     let mut best = (0.0, usize::MAX);
@@ -259,66 +220,27 @@ pub fn compute_pairs<Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN:
     // One material: its lanes once, not a table lookup per lane.
     let single = w.pair_table.single().map(|m| PairMaterial::gather([m; LANES]));
     let PairSlices { pairs, consts, hist, energy, active } = list;
-    let mut acc = match &ledgers {
-        Ledgers::One(l) => **l,
-        Ledgers::PerPair(_) => EnergyLedger::default(),
-    };
-    // The ledger of pair k: the local sum, or the pair's own.
-    macro_rules! ledger {
-        ($k:expr) => {
-            match &mut ledgers {
-                Ledgers::One(_) => &mut acc,
-                Ledgers::PerPair(v) => &mut v[$k],
-            }
-        };
-    }
-    // Close the released pairs listed before pair `limit` (with the ledger).
-    let mut next_released = 0;
-    macro_rules! release_before {
-        ($limit:expr) => {
-            while next_released < released.len() && (released[next_released] as usize) < $limit {
-                let k = released[next_released] as usize;
-                pair_contact::<Dm, T, true>(w, pairs.pairs()[k], &consts[k], &mut hist[k], &mut energy[k], &mut active[k], ledger!(k));
-                next_released += 1;
-            }
-        };
-    }
-    let mut terms = [EnergyTerms::default(); LANES];
     for (ks, ds) in touching[..quads].chunks_exact(LANES).zip(sep.chunks_exact(LANES)) {
         let slices = PairSlices::<T> { pairs, consts, hist: &mut *hist, energy: &mut *energy, active: &mut *active };
-        four_pairs::<Dm, T, ENERGY, SPIN>(w, slices, single.as_ref(), ks, ds, &mut sink, &mut terms, &mut best);
-        if ENERGY {
-            for (t, &k) in terms.iter().zip(ks) {
-                release_before!(k as usize);
-                w.law.add_terms(t, ledger!(k as usize));
-            }
-        }
+        four_pairs::<Dm, T, ENERGY, SPIN>(w, slices, single.as_ref(), ks, ds, &mut sink, &mut best);
     }
     for (m, &k) in touching.iter().enumerate().skip(quads) {
         let k = k as usize;
         let [i, j] = pairs.pairs()[k].map(|g| g as usize);
-        let (o, p) = one_pair::<Dm, T, SPIN>(w, (i, j), sep[m], &consts[k], &mut hist[k], &mut active[k]);
+        let (o, n, state) = one_pair::<Dm, T, SPIN>(w, (i, j), sep[m], &consts[k], &mut hist[k], &mut active[k]);
         if o.ratio > best.0 {
             best = (o.ratio, k);
         }
         sink(k, (i, j), o);
         if ENERGY {
-            let t = w.law.energy_terms(p.n, p.dn, w.dt, &p.state, &mut energy[k]);
-            release_before!(k);
-            w.law.add_terms(&t, ledger!(k));
+            w.law.energy_step(n, w.dt, &state, &mut energy[k]);
         }
     }
-    if !ENERGY {
-        let mut none = EnergyLedger::default();
-        for &k in released {
-            let k = k as usize;
-            pair_contact::<Dm, T, false>(w, pairs.pairs()[k], &consts[k], &mut hist[k], &mut EnergyMemory::default(), &mut active[k], &mut none);
-        }
-        return best;
-    }
-    release_before!(usize::MAX);
-    if let Ledgers::One(l) = ledgers {
-        *l = acc;
+    let mut none = EnergyMemory::default();
+    for &k in released {
+        let k = k as usize;
+        let e = if ENERGY { &mut energy[k] } else { &mut none };
+        pair_contact::<Dm, T, ENERGY>(w, pairs.pairs()[k], &consts[k], &mut hist[k], e, &mut active[k]);
     }
     best
 }

@@ -5,6 +5,7 @@
 
 use crate::kernels::threads::Threads;
 use crate::physics::contact::EnergyMemory;
+use crate::physics::energy::EnergySums;
 
 /// The Verlet list and the history of each listed pair.
 #[derive(Clone, Debug, Default)]
@@ -80,6 +81,11 @@ impl<H: Copy + Default + Send + Sync> PairList<H> {
         self.pairs = Pairs { top: new_pairs.iter().fold(0, |t, p| t.max(p[0].max(p[1]) as usize + 1)), list: new_pairs };
         self.spare = Spare { hist: std::mem::replace(&mut self.hist, hist), active: std::mem::replace(&mut self.active, active), energy: std::mem::replace(&mut self.energy, energy) };
     }
+    /// The energy sums of every listed pair, added in list order
+    /// ([`EnergySums::total`]); zero without the energy ledger.
+    pub fn energy_sums(&self) -> EnergySums {
+        EnergySums::total(self.energy.iter().map(|e| &e.sums))
+    }
     /// Number of pairs currently touching (active history).
     pub fn touching(&self) -> usize {
         self.active.iter().filter(|&&a| a).count()
@@ -107,7 +113,8 @@ struct Carried<'a, H> {
 
 impl<H: Copy + Default> Carried<'_, H> {
     /// The states of the pairs of the sorted stretch `new`: those listed before keep
-    /// theirs, the others start afresh (every entry is written).
+    /// theirs, the others start afresh (every entry is written). The energy sums start
+    /// at 0 in the new list: the ledger has taken the old list's.
     fn carry(&self, new: &[[u32; 2]], hist: &mut [H], active: &mut [bool], mut energy: Option<&mut [EnergyMemory]>) {
         let old = self.pairs;
         let mut k = new.first().map_or(0, |first| old.partition_point(|p| p < first));
@@ -119,7 +126,7 @@ impl<H: Copy + Default> Carried<'_, H> {
             hist[m] = if kept { self.hist[k] } else { H::default() };
             active[m] = kept && self.active[k];
             if let Some(e) = energy.as_deref_mut() {
-                e[m] = if kept { self.energy[k] } else { EnergyMemory::default() };
+                e[m] = if kept { EnergyMemory { sums: EnergySums::default(), ..self.energy[k] } } else { EnergyMemory::default() };
             }
         }
     }
@@ -230,7 +237,8 @@ mod tests {
         list.replace(vec![[0, 1], [0, 2], [3, 4]], &r, &m, &Threads::serial());
         for (k, h) in list.hist.iter_mut().enumerate() {
             *h = k as f64 + 1.0;
-            list.energy[k].ut_prev = 10.0 * (k as f64 + 1.0);
+            list.energy[k].fd_prev = 10.0 * (k as f64 + 1.0);
+            list.energy[k].sums.friction = 1.0;
             list.active[k] = true;
         }
         // [0, 2] leaves, [1, 2] and [2, 3] arrive, the others stay.
@@ -239,8 +247,10 @@ mod tests {
         assert_eq!(list.consts[1].r_star, 0.5);
         let kept: Vec<f64> = list.hist.clone();
         assert_eq!(kept, vec![1.0, 0.0, 0.0, 3.0]);
-        let kept: Vec<f64> = list.energy.iter().map(|e| e.ut_prev).collect();
+        let kept: Vec<f64> = list.energy.iter().map(|e| e.fd_prev).collect();
         assert_eq!(kept, vec![10.0, 0.0, 0.0, 30.0]);
+        // The sums were the ledger's to take before the rebuild: all start at 0.
+        assert!(list.energy.iter().all(|e| e.sums == EnergySums::default()));
         assert_eq!(list.touching(), 2);
     }
 

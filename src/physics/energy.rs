@@ -12,6 +12,20 @@
 //! because its stiffness kt(dn) and its frame change under it. It is a property of the
 //! contact laws (neither LIGGGHTS' nor YADE's tangential spring is conservative), not a
 //! numerical error, and it is the seed's source of energy growth.
+//!
+//! Per contact and step, `W_t` gains `U_t - U_t,prev + E_slip + W_spring`, where
+//! `W_spring` is the trapezoidal work of the elastic tangential force over the contact
+//! displacement. The `U_t` differences add up over a contact's life to the energy its
+//! spring holds now (a released contact's spring holds none), so the ledger keeps
+//! `W_t - U_t` (the sum of `E_slip + W_spring`) and adds the stored `U_t` when it is
+//! read: the same quantity, with fewer roundings, and no stored energy computed at the
+//! steps nobody looks at.
+//!
+//! Where the pair contacts' terms go: each listed pair sums its own ([`EnergySums`], in
+//! its energy memory), with no order between pairs to keep; at each neighbour-list
+//! rebuild and whenever the ledger is read, the pairs' sums are added in list order.
+//! The sums are therefore the same on any number of threads, and the kernel adds to
+//! nothing that another pair adds to.
 
 use serde::Serialize;
 
@@ -26,7 +40,8 @@ pub struct EnergyLedger {
     pub friction: f64,
     /// Energy dissipated by the general (viscous, per-grain) damping, J.
     pub general_damping: f64,
-    /// Energy the tangential spring gained from stiffness and frame changes, J.
+    /// Energy the tangential springs gained from stiffness and frame changes, less the
+    /// elastic energy they hold now (the sum of `E_slip + W_spring`, see the module), J.
     pub tangential_model: f64,
     /// Work done on the grains by the walls' prescribed motion, J.
     pub walls: f64,
@@ -34,9 +49,11 @@ pub struct EnergyLedger {
     pub load: f64,
     /// Work done by gravity, J.
     pub gravity: f64,
-    /// Elastic energy stored in normal springs now (recomputed each step), J.
+    /// Elastic energy stored in normal springs now, J: in the world's ledger, the flat
+    /// walls' contacts of this step (recomputed each step); the pairs' is added when the
+    /// ledger is read.
     pub elastic_normal: f64,
-    /// Elastic energy stored in tangential springs now (recomputed each step), J.
+    /// Elastic energy stored in tangential springs now, J (as `elastic_normal`).
     pub elastic_tangential: f64,
 }
 
@@ -45,6 +62,57 @@ impl EnergyLedger {
     pub fn begin_step(&mut self) {
         self.elastic_normal = 0.0;
         self.elastic_tangential = 0.0;
+    }
+    /// Add a contact's (or many contacts') sums.
+    #[inline]
+    pub fn add(&mut self, s: &EnergySums) {
+        self.normal_damping += s.normal_damping;
+        self.tangential_damping += s.tangential_damping;
+        self.friction += s.friction;
+        self.tangential_model += s.tangential_model;
+    }
+    /// The tangential model's work `W_t`: what the ledger keeps plus the elastic energy
+    /// the tangential springs hold now, J.
+    pub fn tangential_model_work(&self) -> f64 {
+        self.tangential_model + self.elastic_tangential
+    }
+}
+
+/// What one contact has added to the ledger since its sums were last taken (per lane:
+/// of four contacts), J: dissipations positive, as in [`EnergyLedger`].
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct EnergySums<R = f64> {
+    /// Dissipated by normal damping (and by the clamp, if any), J.
+    pub normal_damping: R,
+    /// Dissipated by tangential damping, J.
+    pub tangential_damping: R,
+    /// Dissipated by sliding, J.
+    pub friction: R,
+    /// Tangential model work less the change of the stored tangential energy
+    /// (`E_slip + W_spring`), J.
+    pub tangential_model: R,
+}
+
+impl EnergySums {
+    /// The sums of many contacts' sums, in their order (four partial sums, the contacts
+    /// at indices k = l mod 4 in partial sum l, then added as (0 + 1) + (2 + 3)): a fixed
+    /// order, so the same bits on any number of threads.
+    pub fn total<'a>(sums: impl Iterator<Item = &'a EnergySums>) -> EnergySums {
+        let mut part = [EnergySums::default(); 4];
+        for (k, s) in sums.enumerate() {
+            let p = &mut part[k % 4];
+            p.normal_damping += s.normal_damping;
+            p.tangential_damping += s.tangential_damping;
+            p.friction += s.friction;
+            p.tangential_model += s.tangential_model;
+        }
+        let pair = |a: &EnergySums, b: &EnergySums| EnergySums {
+            normal_damping: a.normal_damping + b.normal_damping,
+            tangential_damping: a.tangential_damping + b.tangential_damping,
+            friction: a.friction + b.friction,
+            tangential_model: a.tangential_model + b.tangential_model,
+        };
+        pair(&pair(&part[0], &part[1]), &pair(&part[2], &part[3]))
     }
 }
 
@@ -100,7 +168,7 @@ impl EnergyRow {
             dissipated_tangential_damping_j: ledger.tangential_damping,
             dissipated_friction_j: ledger.friction,
             dissipated_general_damping_j: ledger.general_damping,
-            tangential_model_work_j: ledger.tangential_model,
+            tangential_model_work_j: ledger.tangential_model_work(),
             work_walls_j: ledger.walls,
             work_load_j: ledger.load,
             work_gravity_j: ledger.gravity,

@@ -6,4 +6,4 @@ pub mod model;
 pub mod normal;
 pub mod tangential;
 
-pub use model::{ContactForce, ContactHistory, EnergyMemory, EnergyTerms, ContactInput, ContactLaw, ContactModel, LeverArm, ModelOptions};
+pub use model::{ContactForce, ContactHistory, EnergyMemory, ContactInput, ContactLaw, ContactModel, LeverArm, ModelOptions};

@@ -12,7 +12,7 @@ use super::damping::{Damping, Undamped, Viscoelastic};
 use super::normal::{HertzStiffness, hertz_energy};
 use super::tangential::{Frictionless, IncrementalForce, Tangential, TangentialForce, TangentialInput, TotalDisplacement};
 use crate::physics::dim::Vec2;
-use crate::physics::energy::EnergyLedger;
+use crate::physics::energy::{EnergyLedger, EnergySums};
 use crate::physics::lanes::{Real, k, pick};
 use crate::physics::material::PairMaterial;
 
@@ -155,7 +155,8 @@ pub struct ContactHistory<H> {
 }
 
 /// What a contact's energy accounting carries from one step to the next: the previous
-/// values of the terms it integrates by the trapezoid rule.
+/// values of the terms it integrates by the trapezoid rule, and the contact's sums of
+/// the ledger's terms since they were last taken ([`crate::physics::energy`]).
 /// (`R = Lanes`: of four contacts.)
 #[derive(Clone, Copy, Debug, Default)]
 pub struct EnergyMemory<R: Real = f64> {
@@ -165,57 +166,57 @@ pub struct EnergyMemory<R: Real = f64> {
     pub fte_prev: Vector2<R>,
     /// Previous tangential damping force, N.
     pub ftd_prev: Vector2<R>,
-    /// Previous tangential elastic energy, J.
-    pub ut_prev: R,
+    /// The ledger's terms this contact added since they were last taken, J.
+    pub sums: EnergySums<R>,
 }
 
 impl EnergyMemory<crate::physics::lanes::Lanes> {
-    /// Four contacts' memories in lanes.
+    /// Four contacts' memories in lanes; with `friction` false only what a frictionless
+    /// contact uses (the normal damping's previous force and sum), the rest 0.
     #[inline(always)]
-    pub fn gather(h: [&EnergyMemory; crate::physics::lanes::LANES]) -> Self {
-        use crate::physics::lanes::{gather, gather2};
-        EnergyMemory { fd_prev: gather(|l| h[l].fd_prev), fte_prev: gather2(|l| h[l].fte_prev), ftd_prev: gather2(|l| h[l].ftd_prev), ut_prev: gather(|l| h[l].ut_prev) }
+    pub fn gather(h: [&EnergyMemory; crate::physics::lanes::LANES], friction: bool) -> Self {
+        use crate::physics::lanes::{Lanes, gather, gather2};
+        use simba::simd::SimdValue;
+        if !friction {
+            let z = Lanes::splat(0.0);
+            let sums = EnergySums { normal_damping: gather(|l| h[l].sums.normal_damping), tangential_damping: z, friction: z, tangential_model: z };
+            return EnergyMemory { fd_prev: gather(|l| h[l].fd_prev), fte_prev: Vector2::new(z, z), ftd_prev: Vector2::new(z, z), sums };
+        }
+        EnergyMemory {
+            fd_prev: gather(|l| h[l].fd_prev),
+            fte_prev: gather2(|l| h[l].fte_prev),
+            ftd_prev: gather2(|l| h[l].ftd_prev),
+            sums: EnergySums {
+                normal_damping: gather(|l| h[l].sums.normal_damping),
+                tangential_damping: gather(|l| h[l].sums.tangential_damping),
+                friction: gather(|l| h[l].sums.friction),
+                tangential_model: gather(|l| h[l].sums.tangential_model),
+            },
+        }
+    }
+    /// Write lane `l`'s memory to `m` (with `friction` false, only what a frictionless
+    /// contact uses).
+    #[inline(always)]
+    pub fn store_lane(&self, l: usize, m: &mut EnergyMemory, friction: bool) {
+        use simba::simd::SimdValue;
+        if friction {
+            *m = self.lane(l);
+        } else {
+            m.fd_prev = self.fd_prev.extract(l);
+            m.sums.normal_damping = self.sums.normal_damping.extract(l);
+        }
     }
     /// The memory in lane `l`.
     #[inline(always)]
     pub fn lane(&self, l: usize) -> EnergyMemory {
         use crate::physics::lanes::lane2;
         use simba::simd::SimdValue;
-        EnergyMemory { fd_prev: self.fd_prev.extract(l), fte_prev: lane2(&self.fte_prev, l), ftd_prev: lane2(&self.ftd_prev, l), ut_prev: self.ut_prev.extract(l) }
-    }
-}
-
-/// What one step of one touching contact (or of four, in lanes) adds to the energy
-/// ledger, J: [`ContactModel::add_terms`] adds them, so that a ledger sums the same
-/// numbers in the same order whether the terms were computed alone or in lanes.
-#[derive(Clone, Copy, Debug, Default)]
-pub struct EnergyTerms<R: Real = f64> {
-    /// Work of the normal damping force over the step (subtracted), J.
-    pub normal_damping: R,
-    /// Elastic energy in the normal spring now, J.
-    pub elastic_normal: R,
-    /// Work of the tangential damping force over the step (subtracted), J.
-    pub tangential_damping: R,
-    /// Energy lost to sliding, J.
-    pub friction: R,
-    /// Work of the tangential model (stiffness and frame changes), J.
-    pub tangential_model: R,
-    /// Elastic energy in the tangential spring now, J.
-    pub elastic_tangential: R,
-}
-
-impl EnergyTerms<crate::physics::lanes::Lanes> {
-    /// The terms of lane `l`.
-    #[inline(always)]
-    pub fn lane(&self, l: usize) -> EnergyTerms {
-        use simba::simd::SimdValue;
-        EnergyTerms {
-            normal_damping: self.normal_damping.extract(l),
-            elastic_normal: self.elastic_normal.extract(l),
-            tangential_damping: self.tangential_damping.extract(l),
-            friction: self.friction.extract(l),
-            tangential_model: self.tangential_model.extract(l),
-            elastic_tangential: self.elastic_tangential.extract(l),
+        let s = &self.sums;
+        EnergyMemory {
+            fd_prev: self.fd_prev.extract(l),
+            fte_prev: lane2(&self.fte_prev, l),
+            ftd_prev: lane2(&self.ftd_prev, l),
+            sums: EnergySums { normal_damping: s.normal_damping.extract(l), tangential_damping: s.tangential_damping.extract(l), friction: s.friction.extract(l), tangential_model: s.tangential_model.extract(l) },
         }
     }
 }
@@ -225,6 +226,10 @@ pub trait ContactLaw: Copy + Send + Sync + 'static {
     type Damp: Damping;
     type Tang: Tangential;
     fn options(&self) -> ModelOptions;
+    /// The elastic energies, normal and tangential (J), a touching contact of materials
+    /// `pm` and reduced radius `r_star` (m) stores at overlap `dn` (m) with elastic
+    /// tangential force `fte` (N) (what the ledger adds for the pairs when it is read).
+    fn stored_energy(&self, pm: &PairMaterial, r_star: f64, dn: f64, fte: Vec2) -> (f64, f64);
     /// One line for `explain`.
     fn describe(&self) -> String {
         let o = self.options();
@@ -283,8 +288,9 @@ impl<Dm: Damping, T: Tangential> ContactModel<Dm, T> {
         ContactState { force, tangential: tf, normal: fnorm, elastic_normal: elastic_n, kn: st.kn, kt: st.kt, vc }
     }
 
-    /// The force of a touching contact, updating its history; with `ENERGY`, the
-    /// trapezoidal work integrals of this step go into `ledger`.
+    /// The force of a touching contact, updating its history; with `ENERGY`, this
+    /// step's energy terms and stored energies go straight into `ledger` (the flat walls'
+    /// contacts, which are few and run in one order).
     #[inline(always)]
     pub fn touch<const ENERGY: bool>(
         &self,
@@ -295,73 +301,61 @@ impl<Dm: Damping, T: Tangential> ContactModel<Dm, T> {
     ) -> ContactForce {
         let s = self.force(c, pm, &mut h.tangential);
         if ENERGY {
-            self.account(c.n, c.dn, c.dt, &s, &mut h.energy, ledger);
+            self.energy_step(c.n, c.dt, &s, &mut h.energy);
+            ledger.add(&std::mem::take(&mut h.energy.sums));
+            let (un, ut) = Self::elastic(s.kn, s.kt, c.dn, s.tangential.elastic);
+            ledger.elastic_normal += un;
+            ledger.elastic_tangential += ut;
         }
         let tf = s.tangential;
         ContactForce { force: s.force, tangential: tf.elastic + tf.damping, normal: s.normal, kn: s.kn }
     }
 
-    /// The trapezoidal work integrals of one step of a touching contact (normal `n`,
-    /// overlap `dn`, m, time step `dt`, s), from what [`ContactModel::force`] computed,
-    /// into `ledger`; the previous-step values in `h` move on.
+    /// One step of a touching contact (of four, in lanes) in its energy memory `h`, from
+    /// what [`ContactModel::force`] computed (normal `n`, time step `dt`, s): the
+    /// trapezoidal work integrals of the step added to its sums, the previous-step
+    /// values moved on. No branch on the data: the same bits per lane as alone.
     #[inline(always)]
-    pub fn account(&self, n: Vec2, dn: f64, dt: f64, s: &ContactState, h: &mut EnergyMemory, ledger: &mut EnergyLedger) {
-        let t = self.energy_terms(n, dn, dt, s, h);
-        self.add_terms(&t, ledger);
-    }
-
-    /// The energy terms of one step of a touching contact (of four, in lanes): see
-    /// [`ContactModel::account`]. No branch on the data: the same bits per lane as alone.
-    #[inline(always)]
-    pub fn energy_terms<R: Real>(&self, n: Vector2<R>, dn: R, dt: R, s: &ContactState<R>, h: &mut EnergyMemory<R>) -> EnergyTerms<R> {
-        let tf = s.tangential;
+    pub fn energy_step<R: Real>(&self, n: Vector2<R>, dt: R, s: &ContactState<R>, h: &mut EnergyMemory<R>) {
         let dc = s.vc * dt;
         let fd = s.normal - s.elastic_normal;
-        let mut t = EnergyTerms { normal_damping: k::<R>(0.5) * (h.fd_prev + fd) * dc.dot(&n), elastic_normal: hertz_energy(s.kn, dn), ..Default::default() };
+        h.sums.normal_damping -= k::<R>(0.5) * (h.fd_prev + fd) * dc.dot(&n);
+        h.fd_prev = fd;
         if T::FRICTION {
-            let ut = pick(s.kt.simd_gt(R::zero()), k::<R>(0.5) * tf.elastic.norm_squared() / s.kt, R::zero());
-            t.tangential_damping = k::<R>(0.5) * (h.ftd_prev + tf.damping).dot(&dc);
-            let w_spring = k::<R>(0.5) * (h.fte_prev + tf.elastic).dot(&dc);
-            t.friction = tf.slip_energy;
-            t.tangential_model = ut - h.ut_prev + tf.slip_energy + w_spring;
-            t.elastic_tangential = ut;
+            let tf = s.tangential;
+            h.sums.tangential_damping -= k::<R>(0.5) * (h.ftd_prev + tf.damping).dot(&dc);
+            h.sums.friction += tf.slip_energy;
+            h.sums.tangential_model += tf.slip_energy + k::<R>(0.5) * (h.fte_prev + tf.elastic).dot(&dc);
             h.fte_prev = tf.elastic;
             h.ftd_prev = tf.damping;
-            h.ut_prev = ut;
         }
-        h.fd_prev = fd;
-        t
     }
 
-    /// Add one contact's energy terms to `ledger`.
+    /// The elastic energies, normal and tangential (J), a touching contact of stiffnesses
+    /// `kn`, `kt` (N/m) stores at overlap `dn` (m) with elastic tangential force `fte` (N).
     #[inline(always)]
-    pub fn add_terms(&self, t: &EnergyTerms, ledger: &mut EnergyLedger) {
-        ledger.normal_damping -= t.normal_damping;
-        ledger.elastic_normal += t.elastic_normal;
-        if T::FRICTION {
-            ledger.tangential_damping -= t.tangential_damping;
-            ledger.friction += t.friction;
-            ledger.tangential_model += t.tangential_model;
-            ledger.elastic_tangential += t.elastic_tangential;
-        }
+    fn elastic(kn: f64, kt: f64, dn: f64, fte: Vec2) -> (f64, f64) {
+        let ut = if T::FRICTION && kt > 0.0 { 0.5 * fte.norm_squared() / kt } else { 0.0 };
+        (hertz_energy(kn, dn), ut)
     }
 
     /// A contact that was touching at the previous step and is not any more: close its
-    /// energy integrals (the force fell to zero over this step) and forget its history:
-    /// the tangential state `t` and (with `ENERGY`) the energy memory `h`.
+    /// energy integrals into its sums (the force fell to zero over this step) and forget
+    /// its history: the tangential state `t` and (with `ENERGY`) the previous-step values
+    /// in `h`. The sums stay, for the ledger to take.
     #[inline(always)]
-    pub fn release<const ENERGY: bool>(&self, c_velocity: Vec2, n: Vec2, dt: f64, t: &mut T::History<f64>, h: &mut EnergyMemory, ledger: &mut EnergyLedger) {
+    pub fn release<const ENERGY: bool>(&self, c_velocity: Vec2, n: Vec2, dt: f64, t: &mut T::History<f64>, h: &mut EnergyMemory) {
         if ENERGY {
             let dc = c_velocity * dt;
-            ledger.normal_damping -= 0.5 * h.fd_prev * dc.dot(&n);
+            h.sums.normal_damping -= 0.5 * h.fd_prev * dc.dot(&n);
             if T::FRICTION {
-                ledger.tangential_damping -= 0.5 * h.ftd_prev.dot(&dc);
-                ledger.tangential_model += -h.ut_prev + 0.5 * h.fte_prev.dot(&dc);
+                h.sums.tangential_damping -= 0.5 * h.ftd_prev.dot(&dc);
+                h.sums.tangential_model += 0.5 * h.fte_prev.dot(&dc);
             }
         }
         *t = Default::default();
         if ENERGY {
-            *h = EnergyMemory::default();
+            *h = EnergyMemory { sums: h.sums, ..Default::default() };
         }
     }
 }
@@ -371,6 +365,11 @@ impl<Dm: Damping, T: Tangential> ContactLaw for ContactModel<Dm, T> {
     type Tang = T;
     fn options(&self) -> ModelOptions {
         self.options
+    }
+    #[inline]
+    fn stored_energy(&self, pm: &PairMaterial, r_star: f64, dn: f64, fte: Vec2) -> (f64, f64) {
+        let st = HertzStiffness::new(pm.e_star, pm.g_star, r_star, dn);
+        Self::elastic(st.kn, st.kt, dn, fte)
     }
 }
 
