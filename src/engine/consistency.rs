@@ -16,16 +16,7 @@ use crate::scene::{Analysis, ControlSpec, Grains, Scene};
 /// grains may have: the watchdog's bound (the run would stop at its first step).
 pub const MAX_START_OVERLAP: f64 = 0.1;
 
-/// Largest overlap a seeded packing may keep after its relaxation, as a fraction of the
-/// smaller radius of the pair: 2e-2. The elastic energy of an overlap dn, released, throws
-/// the two grains apart at about sqrt(E*/rho) (dn/r)^(5/4): 27 m/s for glass at 2e-2,
-/// fifty times the shear cell's wall speed; beyond, a run starts with an explosion, not
-/// a packing. Measured (uniform radii 0.4-0.6 mm, 200 to 5000 grains, seeds 1-3): the
-/// relaxation reaches its 1e-4 of the smallest radius at packing fractions up to 0.7 and
-/// leaves up to 2e-3 at 0.75 (the built-in shear cell: 1.3e-3), once 8e-2 in a cell of
-/// 200 grains; radii from 0.1 to 1 mm at 0.75 leave 1.25e-2 (tests/hard_cases.rs shears
-/// that stably); at 0.8, and for wide lognormal radii from 0.75 on, 1e-2 to 0.5.
-pub const MAX_PACKING_OVERLAP: f64 = 2e-2;
+pub use crate::scene::limits::MAX_PACKING_OVERLAP;
 
 /// Largest distance a grain, a grain's surface (spin) or a wall may move in one step, as
 /// a fraction of the smallest free grain's radius: two grains meeting at this speed
@@ -195,7 +186,8 @@ pub fn start_overlaps(p: &Particles, walls: &[Wall], boundary: &Boundary, names:
                 "grains.pack.packing_fraction",
                 spec.packing_fraction,
                 format!(
-                    "a packing the relaxation frees of overlaps: after its 2000 sweeps two grains still overlap by {ratio:.2e} of the smaller radius, more than {bound}. Use a lower packing_fraction (0.7 relaxes fully), or a narrower radius distribution"
+                    "a packing the relaxation frees of overlaps: after its sweeps (at most {}) two grains still overlap by {ratio:.2e} of the smaller radius, more than {bound}. Use a lower packing_fraction (0.7 relaxes fully), or a narrower radius distribution",
+                    crate::scene::pack::MAX_SWEEPS
                 ),
             ));
         }
