@@ -201,7 +201,7 @@ fn execute(cli: Cli) -> Result<(), Error> {
             }
             let built = build_limited(&scene, threads, &limits)?;
             note!("{}", built.explain());
-            let opts = RunOptions { out: out.clone(), overwrite, progress: !quiet, duration, limits, stop: Some(interrupt_flag()?) };
+            let opts = RunOptions { out: out.clone(), overwrite, progress: !quiet, duration, limits, stop: Some(interrupt_flag()?), command: std::env::args().collect() };
             let RunReport { summary, ending, write_error, unwritten } = run_report(&scene, built, &opts)?;
             note!("{}", timing_table(&summary).trim_end());
             if let Some(w) = summary.energy.as_ref().and_then(|e| e.warning.as_ref()) {

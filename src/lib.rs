@@ -42,7 +42,8 @@
 //! 6. **Output** ([`output`]): only finite numbers ([`finite`]; an undefined quantity is
 //!    empty or `null`): `summary.json` ([`output::summary`]), CSV time series with
 //!    unit-suffixed headers, ParaView `.vtp` frames with a `.pvd` index, in an output
-//!    folder that is grainlab's ([`output::folder`]: a manifest, files that appear whole).
+//!    folder that is grainlab's ([`output::folder`]: a manifest, files that appear whole),
+//!    with the scene as it ran and what produced the run ([`output::provenance`]).
 //! 7. **Studies** ([`study`]): a run with its progress bar, observers and outputs, ended
 //!    early on a stop request with everything written ([`study::run`]); sweeps over time
 //!    steps and model variants ([`study::sweep`]); the accuracy calibration that picks a

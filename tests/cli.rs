@@ -309,3 +309,42 @@ fn export_lists_what_a_code_cannot_express() {
         }
     }
 }
+
+/// An output folder alone repeats its run: `grainlab run DIR/scene.resolved.json` gives the
+/// same bits (the scene as it ran, every default and the `--duration` override in it), and
+/// the summary says what produced the run.
+#[test]
+fn an_output_folder_alone_repeats_its_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let (a, b) = (dir.path().join("a"), dir.path().join("b"));
+    // The shear cell, shortened from the command line, with frames: walls, energy, VTK.
+    let mut scene = builtin_json("shear");
+    scene["output"]["frames"] = serde_json::json!(2);
+    let file = dir.path().join("shear.json");
+    std::fs::write(&file, serde_json::to_string(&scene).unwrap()).unwrap();
+    grainlab().args(["run", file.to_str().unwrap(), "--quiet", "--duration", "2e-5", "--out", a.to_str().unwrap()]).assert().success();
+    let resolved = a.join("scene.resolved.json");
+    let again: Value = serde_json::from_str(&std::fs::read_to_string(&resolved).unwrap()).unwrap();
+    assert_eq!(again["duration"], serde_json::json!(2e-5), "the duration the run was given");
+    assert_eq!(again["neighbor"]["skin"], scene["neighbor"]["skin"], "defaults written out");
+    grainlab().args(["run", resolved.to_str().unwrap(), "--quiet", "--out", b.to_str().unwrap()]).assert().success();
+    let mut compared = 0;
+    for f in ["energy.csv", "walls.csv", "frames/grains_00000.vtp", "frames/grains_00001.vtp", "scene.resolved.json"] {
+        let (x, y) = (std::fs::read(a.join(f)), std::fs::read(b.join(f)));
+        if let (Ok(x), Ok(y)) = (x, y) {
+            assert!(x == y, "{f} differs between the run and its repeat");
+            compared += 1;
+        }
+    }
+    assert!(compared >= 4, "the series, a frame and the scene compared");
+    // The summary's provenance.
+    let summary: Value = serde_json::from_str(&std::fs::read_to_string(a.join("summary.json")).unwrap()).unwrap();
+    let p = &summary["provenance"];
+    assert_eq!(p["grainlab"], serde_json::json!(env!("CARGO_PKG_VERSION")));
+    assert!(p["commit"].as_str().is_some_and(|c| c == "unknown" || c.len() >= 40), "{p}");
+    assert!(p["command"].as_array().is_some_and(|c| c.iter().any(|a| a == "--duration")), "{p}");
+    assert!(p["cpu"].as_str().is_some_and(|c| !c.is_empty()) && p["threads"] == serde_json::json!(1), "{p}");
+    let (start, end) = (p["started_utc"].as_str().unwrap(), p["ended_utc"].as_str().unwrap());
+    assert!(start.ends_with('Z') && start.len() == 20 && end >= start, "{start} .. {end}");
+    assert_eq!(p["scene_file"], serde_json::json!("scene.resolved.json"));
+}

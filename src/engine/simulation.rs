@@ -89,6 +89,8 @@ pub trait Engine: Send {
     fn touching(&self) -> usize;
     /// Number of neighbour-list builds so far.
     fn neighbour_builds(&self) -> u64;
+    /// Threads the stages may use.
+    fn threads(&self) -> usize;
     /// The stages in order.
     fn stage_names(&self) -> Vec<String>;
     fn timings(&self) -> Vec<(String, Duration)>;
@@ -135,6 +137,9 @@ impl<L: ContactLaw> Engine for Simulation<L> {
     }
     fn neighbour_builds(&self) -> u64 {
         self.world.neighbours.builds
+    }
+    fn threads(&self) -> usize {
+        self.world.threads.count()
     }
     fn stage_names(&self) -> Vec<String> {
         Simulation::stage_names(self)

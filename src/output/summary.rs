@@ -35,6 +35,9 @@ pub struct Summary {
     pub impact: Option<ImpactSummary>,
     pub shear: Option<ShearSummary>,
     pub stage_timing: Vec<StageTime>,
+    /// What produced the run: grainlab's version and commit, the command line, the CPU,
+    /// the threads, the start and end ([`crate::output::provenance`]).
+    pub provenance: crate::output::provenance::Provenance,
 }
 
 /// The stage timing table as text.

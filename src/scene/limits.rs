@@ -211,6 +211,17 @@ pub fn read_bounded(path: &std::path::Path, limit: u64, field: &str) -> Result<S
     String::from_utf8(bytes).map_err(|_| Error::Invalid { field: field.into(), value: shown.to_string(), allowed: "a UTF-8 text file".into() })
 }
 
+/// Largest overlap a seeded packing may keep after its relaxation, as a fraction of the
+/// smaller radius of the pair: 2e-2. The elastic energy of an overlap dn, released, throws
+/// the two grains apart at about sqrt(E*/rho) (dn/r)^(5/4): 27 m/s for glass at 2e-2,
+/// fifty times the shear cell's wall speed; beyond, a run starts with an explosion, not
+/// a packing. Measured (uniform radii 0.4-0.6 mm, 200 to 5000 grains, seeds 1-3): the
+/// relaxation ([`crate::scene::pack`]) reaches its 1e-4 of the smallest radius at packing fractions up to 0.7 and
+/// leaves up to 2e-3 at 0.75 (the built-in shear cell: 1.3e-3), once 8e-2 in a cell of
+/// 200 grains; radii from 0.1 to 1 mm at 0.75 leave 1.25e-2 (tests/hard_cases.rs shears
+/// that stably); at 0.8, and for wide lognormal radii from 0.75 on, 1e-2 to 0.5.
+pub const MAX_PACKING_OVERLAP: f64 = 2e-2;
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -238,14 +249,3 @@ mod tests {
         assert!(msg.contains("grains.pack.count = 1048576") && msg.contains("64.0 MiB") && msg.contains("1.0 GiB for grains"), "{msg}");
     }
 }
-
-/// Largest overlap a seeded packing may keep after its relaxation, as a fraction of the
-/// smaller radius of the pair: 2e-2. The elastic energy of an overlap dn, released, throws
-/// the two grains apart at about sqrt(E*/rho) (dn/r)^(5/4): 27 m/s for glass at 2e-2,
-/// fifty times the shear cell's wall speed; beyond, a run starts with an explosion, not
-/// a packing. Measured (uniform radii 0.4-0.6 mm, 200 to 5000 grains, seeds 1-3): the
-/// relaxation ([`crate::scene::pack`]) reaches its 1e-4 of the smallest radius at packing fractions up to 0.7 and
-/// leaves up to 2e-3 at 0.75 (the built-in shear cell: 1.3e-3), once 8e-2 in a cell of
-/// 200 grains; radii from 0.1 to 1 mm at 0.75 leave 1.25e-2 (tests/hard_cases.rs shears
-/// that stably); at 0.8, and for wide lognormal radii from 0.75 on, 1e-2 to 0.5.
-pub const MAX_PACKING_OVERLAP: f64 = 2e-2;

@@ -17,6 +17,7 @@ use crate::observe::impact::ImpactObserver;
 use crate::observe::stress::{ShearSummary, WallAverager, WallRow, stress_estimates};
 use crate::output::csv::CsvSeries;
 use crate::output::folder::OutFolder;
+use crate::output::provenance::{Provenance, RESOLVED_SCENE, resolved};
 use crate::output::summary::{StageTime, Summary};
 use crate::output::vtk::VtkSeries;
 use crate::physics::energy::EnergyRow;
@@ -39,6 +40,8 @@ pub struct RunOptions {
     /// way: it then writes everything with `status: "interrupted"` and ends with
     /// [`Error::Interrupted`]. Read once a step (a relaxed atomic load).
     pub stop: Option<Arc<AtomicBool>>,
+    /// The command line that started the run, for its provenance (empty from the library).
+    pub command: Vec<String>,
 }
 
 
@@ -108,9 +111,12 @@ pub fn run_report(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<
     let (total, sample_every) = schedule(duration, dt, scene.output.samples);
     let frame_every = if scene.output.frames > 0 { Some((total / scene.output.frames).max(1)) } else { None };
     let energy_on = scene.output.energy;
+    let started = std::time::SystemTime::now();
     let mut outputs = Outputs { folder: None, energy: None, walls: None, vtk: None };
     if let Some(dir) = &opts.out {
         let mut folder = OutFolder::claim(dir, opts.overwrite, &format!("run {}", scene.name))?;
+        // The scene as it runs: the folder alone repeats the run.
+        folder.write(RESOLVED_SCENE, (serde_json::to_string_pretty(&resolved(scene, duration)).expect("serialisable") + "\n").as_bytes())?;
         if energy_on {
             outputs.energy = Some(folder.series("energy.csv")?);
         }
@@ -247,6 +253,8 @@ pub fn run_report(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<
     let total_t: f64 = timings.iter().map(|t| t.1.as_secs_f64()).sum::<f64>().max(f64::MIN_POSITIVE);
     let stage_timing = timings.iter().map(|(s, d)| StageTime { stage: s.clone(), seconds: d.as_secs_f64(), share: d.as_secs_f64() / total_t }).collect();
     let shear = (scene.analysis == Analysis::Shear && wall_rows.len() >= 4).then(|| shear_summary(&wall_rows, e.particles(), built.length));
+    let mut provenance = Provenance::new(started, e.threads(), &opts.command, opts.out.as_ref().map(|_| RESOLVED_SCENE.to_string()));
+    provenance.end();
     let p = e.particles();
     let summary = Summary {
         scene: scene.name.clone(),
@@ -269,6 +277,7 @@ pub fn run_report(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<
         impact: impact.as_ref().and_then(|o| o.summary()),
         shear,
         stage_timing,
+        provenance,
     };
     // Every number in the summary is finite (an undefined one is `None`): a number that is
     // not would be written as `null` without a word, so the run says so instead.
