@@ -207,6 +207,8 @@ fn execute(cli: Cli) -> Result<(), Error> {
             if let Some(w) = summary.energy.as_ref().and_then(|e| e.warning.as_ref()) {
                 note!("warning: {w}");
             }
+            // The run in one line, before the JSON.
+            note!("{}", grainlab::output::summary::headline(&summary));
             // Always printed: when summary.json could not be written, this is its copy.
             let printed = say!("{}", serde_json::to_string_pretty(&summary).expect("serialisable"));
             let dir = out.as_deref().unwrap_or(std::path::Path::new("")).display();

@@ -348,3 +348,21 @@ fn an_output_folder_alone_repeats_its_run() {
     assert!(start.ends_with('Z') && start.len() == 20 && end >= start, "{start} .. {end}");
     assert_eq!(p["scene_file"], serde_json::json!("scene.resolved.json"));
 }
+
+/// Without a terminal a run prints a progress line at each tenth (simulated time, latest
+/// tau/sigma), and every run ends with one headline line before the JSON.
+#[test]
+fn a_run_reports_progress_lines_and_a_headline() {
+    let out = grainlab().args(["run", "shear", "--duration", "2e-4"]).output().unwrap();
+    assert!(out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    let progress: Vec<&str> = err.lines().filter(|l| l.starts_with("shear t = ") && l.contains("% of ")).collect();
+    assert_eq!(progress.len(), 10, "{err}");
+    assert!(progress.last().unwrap().contains("100% of"), "{err}");
+    let headline = err.lines().find(|l| l.starts_with("shear: completed; tau/sigma = ")).unwrap_or_else(|| panic!("{err}"));
+    assert!(headline.contains("(95%, 10 blocks)") && headline.contains("sigma = ") && headline.contains("energy residual"), "{headline}");
+    // --quiet: no progress, the headline still.
+    let out = grainlab().args(["run", "shear", "--duration", "2e-4", "--quiet"]).output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!err.contains("% of ") && err.contains("shear: completed;"), "{err}");
+}

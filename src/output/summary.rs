@@ -55,3 +55,24 @@ pub fn timing_table(s: &Summary) -> String {
     );
     out
 }
+
+/// The run in one line, for a person: how it ended, tau/sigma with its 95% interval and
+/// the normal stress (shear), the restitution coefficient (impact), the energy balance's
+/// largest residual, and the rate.
+pub fn headline(s: &Summary) -> String {
+    let mut parts = vec![format!("{}: {}", s.scene, s.status)];
+    if let Some(sh) = &s.shear {
+        if let Some(r) = &sh.stress_ratio {
+            parts.push(format!("tau/sigma = {:.3} +- {:.3} (95%, {} blocks)", r.mean, r.ci95, r.blocks));
+        }
+        parts.push(format!("sigma = {:.3e} Pa", sh.normal_stress_pa.mean));
+    }
+    if let Some(i) = &s.impact {
+        parts.push(format!("e_n = {:.4}", i.restitution_normal));
+    }
+    if let Some(e) = &s.energy {
+        parts.push(format!("energy residual {:.1e} of the input", e.max_residual_rel));
+    }
+    parts.push(format!("{} grains x {} steps in {:.1} s", s.grains, s.steps, s.wall_time_s));
+    parts.join("; ")
+}

@@ -1,6 +1,7 @@
 //! Running a scene: the step loop, the observers, the outputs, the progress bar and the
 //! stage timing table.
 
+use std::io::Write as _;
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -30,7 +31,8 @@ pub struct RunOptions {
     pub out: Option<PathBuf>,
     /// Delete the files an earlier grainlab command listed in `out`'s manifest first.
     pub overwrite: bool,
-    /// Show a progress bar on stderr (when it is a terminal and the run is long).
+    /// Show progress on stderr: a bar with the simulated time and the latest tau/sigma when
+    /// stderr is a terminal, else a line at every tenth of the run.
     pub progress: bool,
     /// Override the scene's duration, s.
     pub duration: Option<f64>,
@@ -176,7 +178,10 @@ pub fn run_report(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<
         };
     }
     let stop = opts.stop.as_deref();
-    let bar = if opts.progress {
+    use std::io::IsTerminal as _;
+    let lines = opts.progress && !std::io::stderr().is_terminal();
+    let mut next_line = 1;
+    let bar = if opts.progress && !lines {
         let b = ProgressBar::new(total);
         b.set_style(ProgressStyle::with_template("{msg} [{bar:40}] {percent}% {elapsed_precise} eta {eta}").expect("template").progress_chars("=> "));
         b.set_message(scene.name.clone());
@@ -232,6 +237,14 @@ pub fn run_report(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<
             && let Some(b) = &bar
         {
             b.set_position(k);
+            b.set_message(progress_message(&scene.name, e.time(), wall_rows.last()));
+        }
+        // Without a terminal, a line at each tenth of the run.
+        if lines && k * 10 >= next_line * total {
+            next_line = k * 10 / total + 1;
+            let secs = t0.elapsed().as_secs_f64();
+            let eta = secs * (total - k) as f64 / k as f64;
+            let _ = writeln!(std::io::stderr().lock(), "{}: {}% of {} steps, {secs:.1} s, eta {eta:.1} s", progress_message(&scene.name, e.time(), wall_rows.last()), 100 * k / total, total);
         }
         if stopping {
             error = Some(Error::Interrupted { step: e.steps(), time: e.time() });
@@ -302,6 +315,13 @@ pub fn run_report(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<
         or_note!("manifest.json", folder.finish(&summary.status));
     }
     Ok(RunReport { summary, ending: error, write_error, unwritten })
+}
+
+/// What the progress shows besides the steps: the scene, the simulated time and the latest
+/// tau/sigma (with walls).
+fn progress_message(name: &str, time: f64, row: Option<&WallRow>) -> String {
+    let ratio = row.and_then(|r| r.stress_ratio).map(|x| format!(", tau/sigma {x:.3}")).unwrap_or_default();
+    format!("{name} t = {time:.3e} s{ratio}")
 }
 
 /// The shear estimates of a run's wall rows, and the packing fraction at the last row (its
