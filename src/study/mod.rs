@@ -1,10 +1,11 @@
 //! Studies: a scene built and run with its observers and outputs ([`run`]), over time
-//! steps and model variants ([`sweep`]), and the accuracy calibration that resolves an
+//! steps and model variants ([`sweep`]), over packing seeds ([`ensemble`]), and the accuracy calibration that resolves an
 //! accuracy rule into a time step before the engine is built ([`accuracy`]).
 //! May use: everything below it (`output`, `observe`, `engine`, `scene`, `kernels`,
 //! `physics`).
 
 pub mod accuracy;
+pub mod ensemble;
 pub mod run;
 pub mod sweep;
 
