@@ -24,9 +24,12 @@
 //! it waits for their threads to publish, which they do first thing), (4) computes its
 //! touching pairs four at a time, adding each result as it comes, in list order (or
 //! keeping it, for a wall's grain on a thread after the first), (5) adds its own cross
-//! pairs to their first grains: a grain's pairs (g, j) with j in a later range have the
-//! largest j, so they are the last of its sequence, and publishes what it kept for the
-//! walls' grains; (6) the first thread adds those, range by range. Then the largest
+//! pairs to their first grains (a grain's pairs (g, j) with j in a later range come after
+//! its other pairs with free grains), then its pairs with the rough walls' grains to their
+//! first grains (those grains have the largest indices of all, so these pairs end the
+//! sequence; added in (4), before the cross pairs, they made the bits depend on where the
+//! ranges were cut, which follows the threads' timings), and publishes what it kept for
+//! the walls' grains; (6) the first thread adds those, range by range. Then the largest
 //! overlap is picked as the serial loop would. Each pair adds its energy terms to its own
 //! sums, which the ledger adds in list order when it takes them: no order to restore.
 //! `tests/parallel.rs` checks identical bits with 1, 2 and 3 threads.
@@ -90,6 +93,10 @@ struct Scratch {
     /// What the thread's pairs did to rough walls' grains this step, in list order (the
     /// threads after the first: the first owns those grains).
     wall_out: Vec<WallOut>,
+    /// What the thread's pairs with rough walls' grains did to their first grains, in list
+    /// order, added after the thread's cross pairs: a wall's grains have the largest
+    /// indices, so a grain's pairs with them end its sequence, after its cross pairs.
+    wall_first: Vec<(u32, PairOut)>,
     /// Time the thread worked in this stage since the ranges were last cut (not counting
     /// waits for other threads).
     busy: Duration,
@@ -408,7 +415,7 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN: bool> Stage<Con
                 let start = Instant::now();
                 let mut waited = Duration::ZERO;
                 let (g0, part) = (bounds[r], pb[r]..pb[r + 1]);
-                let Scratch { touching, sep, released, worst, cross_out, wall_out, busy } = sc;
+                let Scratch { touching, sep, released, worst, cross_out, wall_out, wall_first, busy } = sc;
                 // If this thread panics before it publishes, the others must not wait for it.
                 let _guard = (Publish(&published[r]), Publish(&published_walls[r]));
                 // (1) Our cross pairs first, as the serial stage does its pairs: sort out the
@@ -453,10 +460,16 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN: bool> Stage<Con
                 // to one for it, in list order.
                 let list = PairSlices::<T> { pairs: checked.part(part.clone()), consts: &consts[part.clone()], hist, energy, active };
                 wall_out.clear();
+                wall_first.clear();
                 let mut add = |(i, j): (usize, usize), o: &PairOut, own: bool| {
-                    fl[i - g0] += o.force;
-                    if T::FRICTION && SPIN {
-                        tl[i - g0] -= o.torque[0];
+                    if own && j >= n_free {
+                        // Its first grain's share after the cross pairs, below.
+                        wall_first.push((i as u32, *o));
+                    } else {
+                        fl[i - g0] += o.force;
+                        if T::FRICTION && SPIN {
+                            tl[i - g0] -= o.torque[0];
+                        }
                     }
                     if own {
                         if j < n_free {
@@ -481,6 +494,14 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN: bool> Stage<Con
                         if oc.ratio > best.0 || (oc.ratio == best.0 && k < best.1) {
                             best = (oc.ratio, k);
                         }
+                    }
+                }
+                // ... and after them its pairs with the rough walls' grains, which have the
+                // largest indices of all: the end of its sequence.
+                for &(i, o) in wall_first.iter() {
+                    fl[i as usize - g0] += o.force;
+                    if T::FRICTION && SPIN {
+                        tl[i as usize - g0] -= o.torque[0];
                     }
                 }
                 let _ = published_walls[r].set(wall_out);
