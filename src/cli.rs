@@ -207,15 +207,21 @@ macro_rules! note {
     }};
 }
 
+/// A `--duration` override: a finite time > 0 s.
+fn check_duration(duration: Option<f64>) -> Result<(), Error> {
+    match duration {
+        Some(d) => grainlab::error::check_option(d.is_finite() && d > 0.0, "--duration", d, "> 0 s"),
+        None => Ok(()),
+    }
+}
+
 fn execute(cli: Cli) -> Result<(), Error> {
     let limits = cli.memory_budget.map_or_else(Limits::machine, Limits::with_memory);
     let load_scene = |arg: &str| grainlab::scene::builtin::load(arg, &limits);
     match cli.command {
         Command::Run { scene, out, overwrite, duration, quiet, threads } => {
             let scene = load_scene(&scene)?;
-            if let Some(d) = duration {
-                grainlab::error::check_option(d.is_finite() && d > 0.0, "--duration", d, "> 0 s")?;
-            }
+            check_duration(duration)?;
             if let Some(dir) = &out {
                 // Refused before a long build; the run claims the folder when it starts.
                 OutFolder::check(dir, overwrite)?;
@@ -323,9 +329,7 @@ fn execute(cli: Cli) -> Result<(), Error> {
             use grainlab::study::ensemble::{ensemble, parse_seeds};
             let scene = load_scene(&scene)?;
             let seeds = parse_seeds(&seeds)?;
-            if let Some(d) = duration {
-                grainlab::error::check_option(d.is_finite() && d > 0.0, "--duration", d, "> 0 s")?;
-            }
+            check_duration(duration)?;
             if let Some(dir) = &out {
                 OutFolder::check(dir, overwrite)?;
             }

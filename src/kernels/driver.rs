@@ -1,8 +1,9 @@
 //! The contact kernel driver: each touching pair's input gathered from the grains'
 //! slices, the contact law run one pair or four in SIMD lanes with the same bits, each
 //! pair's force and torque handed to a sink in list order, each pair's energy terms
-//! added to its own sums (no order between pairs to keep). It reads a view of the grains ([`PairView`]) and the list's slices
-//! ([`PairSlices`]): no World, no Engine. Uses physics and the pair list.
+//! added to its own sums (no order between pairs to keep). It reads a view of the grains
+//! ([`PairView`]) and the list's slices ([`PairSlices`]): no World, no Engine. Uses
+//! physics and the pair list.
 
 use nalgebra::Vector2;
 use simba::simd::{SimdBool, SimdPartialOrd, SimdValue};

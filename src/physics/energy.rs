@@ -93,6 +93,18 @@ pub struct EnergySums<R = f64> {
     pub tangential_model: R,
 }
 
+impl std::ops::Add for EnergySums {
+    type Output = EnergySums;
+    fn add(self, b: EnergySums) -> EnergySums {
+        EnergySums {
+            normal_damping: self.normal_damping + b.normal_damping,
+            tangential_damping: self.tangential_damping + b.tangential_damping,
+            friction: self.friction + b.friction,
+            tangential_model: self.tangential_model + b.tangential_model,
+        }
+    }
+}
+
 impl EnergySums {
     /// The sums of many contacts' sums, in their order (four partial sums, the contacts
     /// at indices k = l mod 4 in partial sum l, then added as (0 + 1) + (2 + 3)): a fixed
@@ -100,19 +112,9 @@ impl EnergySums {
     pub fn total<'a>(sums: impl Iterator<Item = &'a EnergySums>) -> EnergySums {
         let mut part = [EnergySums::default(); 4];
         for (k, s) in sums.enumerate() {
-            let p = &mut part[k % 4];
-            p.normal_damping += s.normal_damping;
-            p.tangential_damping += s.tangential_damping;
-            p.friction += s.friction;
-            p.tangential_model += s.tangential_model;
+            part[k % 4] = part[k % 4] + *s;
         }
-        let pair = |a: &EnergySums, b: &EnergySums| EnergySums {
-            normal_damping: a.normal_damping + b.normal_damping,
-            tangential_damping: a.tangential_damping + b.tangential_damping,
-            friction: a.friction + b.friction,
-            tangential_model: a.tangential_model + b.tangential_model,
-        };
-        pair(&pair(&part[0], &part[1]), &pair(&part[2], &part[3]))
+        (part[0] + part[1]) + (part[2] + part[3])
     }
 }
 
