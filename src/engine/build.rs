@@ -36,6 +36,8 @@ pub struct Built {
     pub length: f64,
     /// Each effect on or off and why ([`Effects`]).
     pub effects: Effects,
+    /// A protocol's stages in one line ([`Scene::describe_stages`]).
+    pub stages: Option<String>,
 }
 
 impl Built {
@@ -61,8 +63,9 @@ impl Built {
             ),
             None => String::new(),
         };
+        let stages = self.stages.as_ref().map(|s| format!("; {s}")).unwrap_or_default();
         format!(
-            "{} (dt = {:.3e} s = t_c/{:.1}, t_c = {:.3e} s at {} m/s; stability limit {:.3e} s{accuracy})",
+            "{} (dt = {:.3e} s = t_c/{:.1}, t_c = {:.3e} s at {} m/s; stability limit {:.3e} s{accuracy}){stages}",
             parts.join(" -> "),
             ts.dt_s,
             ts.steps_per_contact,
@@ -248,7 +251,7 @@ pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<B
                     let start = p.len();
                     for k in 0..count {
                         let x = x0 + (k as f64 + 0.5) * length / count as f64;
-                        push(&mut p, Vec2::new(x, y), Vec2::new(spec.velocity_x, 0.0), 0.0, radius, spec.material);
+                        push(&mut p, Vec2::new(x, y), Vec2::new(spec.velocity_x, spec.velocity_y), 0.0, radius, spec.material);
                     }
                     Surface::Rough { grains: start..p.len() }
                 }
@@ -257,10 +260,7 @@ pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<B
                 Surface::Rough { grains } => grains.clone().map(|k| p.m[k]).sum(),
                 Surface::Flat => (length / (2.0 * mean_r)) * shape.mass(mean_r, mats[spec.material].density),
             });
-            let control = match spec.control {
-                ControlSpec::Fixed => Control::Fixed,
-                ControlSpec::Pressure(pa) => Control::Load { force: pa * length * depth },
-            };
+            let control = control(&spec.control, length, depth);
             walls.push(Wall {
                 name,
                 surface,
@@ -268,7 +268,7 @@ pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<B
                 side,
                 y,
                 x_shift: 0.0,
-                v: Vec2::new(spec.velocity_x, 0.0),
+                v: Vec2::new(spec.velocity_x, spec.velocity_y),
                 mass,
                 glued_radius: rough_r,
                 material: spec.material,
@@ -314,9 +314,19 @@ pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<B
     let time_step = choose(&ts.rule, ts.characteristic_speed, ts.allow_unstable, &refs, (r, m, mat), friction)?;
     let dt = time_step.dt_s;
     let steps = crate::engine::timestep::step_count(scene.duration, dt, "duration")?;
+    // Every stage of a protocol takes at least a step.
+    let counts = crate::engine::timestep::stage_steps(scene.stages.iter().map(|s| s.duration), dt);
+    if let Some(k) = counts.iter().position(|&n| n == 0) {
+        return Err(Error::Invalid {
+            field: format!("stages[{k}].duration"),
+            value: format!("{} s", scene.stages[k].duration),
+            allowed: format!("a stage of at least one step (dt = {dt:.3e} s): it begins and ends within the same step"),
+        });
+    }
     // The rows the summary keeps: a wall row per sample, an impact curve point per step
     // in contact (at most every step, and at most MAX_CURVE_POINTS).
-    let samples = (scene.output.samples as f64).min(steps as f64);
+    let samples = if scene.stages.is_empty() { scene.output.samples as f64 } else { scene.stages.iter().map(|st| st.samples.unwrap_or(scene.output.samples) as f64).sum() };
+    let samples = samples.min(steps as f64);
     let (rows, field, value) = if scene.analysis == Analysis::Impact {
         let curve = (steps as f64).min(crate::scene::limits::MAX_CURVE_POINTS as f64);
         (curve + samples, "duration".to_string(), format!("{} s ({steps} steps of {dt:.3e} s)", scene.duration))
@@ -327,6 +337,7 @@ pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<B
     limits.check(&estimate)?;
     consistency::motion(&p, &walls, Vec2::from(scene.gravity), &names, dt)?;
     consistency::load(scene, &p, &walls, length, depth, dt)?;
+    consistency::stages(scene, &p, &walls, length, depth, dt)?;
     consistency::stable_for_every_pair(scene, &p, &walls, &time_step, friction)?;
     consistency::drag(scene, dt)?;
     consistency::impact(scene, &p, &walls, &boundary, scene.duration)?;
@@ -358,7 +369,16 @@ pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<B
         (TangentialSpec::IncrementalForce, false) => parts.assemble(YadeMindlin::new(options))?,
         (TangentialSpec::IncrementalForce, true) => parts.assemble(YadeMindlinElastic::new(options))?,
     };
-    Ok(Built { engine, time_step, depth, length, effects })
+    Ok(Built { engine, time_step, depth, length, effects, stages: scene.describe_stages() })
+}
+
+/// A wall's control in the engine's terms: a pressure (Pa) becomes the force on the
+/// wall's area, `length` x `depth` (m).
+pub fn control(spec: &ControlSpec, length: f64, depth: f64) -> Control {
+    match *spec {
+        ControlSpec::Fixed => Control::Fixed,
+        ControlSpec::Pressure(pa) => Control::Load { force: pa * length * depth },
+    }
 }
 
 /// The x extent of grains given as (x, r), m.
@@ -376,9 +396,9 @@ fn travel(scene: &Scene, p: &Particles, walls: &[Wall]) -> f64 {
     let n = p.n_free;
     let energy: f64 = (0..n).map(|i| 0.5 * p.m[i] * p.v[i].norm_squared() + 0.5 * p.inertia[i] * p.omega[i] * p.omega[i]).sum();
     let m_min = p.m[..n].iter().cloned().fold(f64::INFINITY, f64::min);
-    let v_walls = walls.iter().map(|w| w.v.norm()).fold(0.0, f64::max);
+    let v_walls = walls.iter().map(|w| w.v.norm()).fold(scene.fastest_wall(), f64::max);
     let t = scene.duration;
-    let g = Vec2::from(scene.gravity).norm();
+    let g = scene.strongest_gravity();
     let speed = (2.0 * energy / m_min).sqrt() + 2.0 * v_walls + g * t;
     4.0 * speed * t
 }
@@ -407,6 +427,8 @@ impl Parts<'_> {
         let has_walls = !self.walls.is_empty();
         let has_flat = self.walls.iter().any(Wall::is_flat);
         let gravity = Vec2::from(scene.gravity);
+        // A stage that turns gravity on needs its stage from the start.
+        let pulled = scene.strongest_gravity() > 0.0;
         let n_free = self.p.n_free;
         let wall_hist = self.walls.iter().map(|w| if w.is_flat() { vec![ContactHistory::default(); n_free] } else { Vec::new() }).collect();
         let wall_active = self.walls.iter().map(|w| vec![false; if w.is_flat() { n_free } else { 0 }]).collect();
@@ -437,7 +459,7 @@ impl Parts<'_> {
         let threads = self.threads.clone();
         let forces = || -> Result<Vec<Box<dyn Stage<L<Dm, T>>>>, Error> {
             let mut s: Vec<Box<dyn Stage<L<Dm, T>>>> = vec![Box::new(UpdateNeighbours), Box::new(ClearForces)];
-            if gravity != Vec2::zeros() {
+            if pulled {
                 s.push(Box::new(Gravity::<E>));
             }
             if let Some(c) = scene.model.general_damping {

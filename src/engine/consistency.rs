@@ -323,6 +323,50 @@ pub fn load(scene: &Scene, p: &Particles, walls: &[Wall], length: f64, depth: f6
     let Some(ws) = &scene.walls else { return Ok(()) };
     let ControlSpec::Pressure(pressure) = ws.top.control else { return Ok(()) };
     let Some(wall) = walls.iter().find(|w| matches!(w.control, Control::Load { .. })) else { return Ok(()) };
+    load_on(scene, p, walls, wall, pressure, "walls.top", length, depth, dt)
+}
+
+/// Each stage of a protocol as [`motion`] and [`load`] check the scene's start: the walls'
+/// speeds, gravity, and each load a stage puts on the top wall.
+pub fn stages(scene: &Scene, p: &Particles, walls: &[Wall], length: f64, depth: f64, dt: f64) -> Result<(), Error> {
+    let r_min = p.r[..p.n_free].iter().cloned().fold(f64::INFINITY, f64::min);
+    let most = MAX_STEP_MOVE * r_min;
+    let allowed = |what: &str, now: f64| format!("{what} of at most {most:.3e} m per step ({MAX_STEP_MOVE} of the smallest radius) at dt = {dt:.3e} s; it moves {now:.3e} m: use a smaller time step or a lower speed");
+    let mut v: Vec<Vec2> = walls.iter().map(|w| w.v).collect();
+    let n_walls = v.len();
+    for (k, st) in scene.stages.iter().enumerate() {
+        for (w, (name, c)) in [("bottom", &st.walls.bottom), ("top", &st.walls.top)].into_iter().enumerate().filter(|(w, _)| *w < n_walls) {
+            let at = format!("stages[{k}].walls.{name}");
+            if let Some(x) = c.velocity_x {
+                v[w].x = x;
+            }
+            if c.control.is_some() {
+                v[w].y = 0.0;
+            }
+            if let Some(y) = c.velocity_y {
+                v[w].y = y;
+            }
+            let step = v[w].norm() * dt;
+            if !(step <= most) {
+                return Err(refuse(format!("{at}.velocity_x"), format!("[{}, {}] m/s", v[w].x.shown(), v[w].y.shown()), allowed("a wall speed", step)));
+            }
+            if let Some(ControlSpec::Pressure(pa)) = c.control {
+                load_on(scene, p, walls, &walls[w], pa, &at, length, depth, dt)?;
+            }
+        }
+        if let Some(g) = st.gravity {
+            let step = Vec2::from(g).norm() * dt * dt;
+            if !(step <= most) {
+                return Err(refuse(format!("stages[{k}].gravity"), format!("[{}, {}] m/s^2", g[0].shown(), g[1].shown()), allowed("a gravity that adds", step)));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// [`load`] for a pressure (Pa) on `wall`, set at `at` (a JSON path).
+#[allow(clippy::too_many_arguments)]
+fn load_on(scene: &Scene, p: &Particles, walls: &[Wall], wall: &Wall, pressure: f64, at: &str, length: f64, depth: f64, dt: f64) -> Result<(), Error> {
     let n_free = p.n_free;
     let r_mean = p.r[..n_free].iter().sum::<f64>() / n_free as f64;
     // The softest pair of materials the grains and walls use.
@@ -341,7 +385,7 @@ pub fn load(scene: &Scene, p: &Particles, walls: &[Wall], length: f64, depth: f6
     if !(dn <= most) {
         let p_max = 4.0 / 3.0 * e_star * r_star.sqrt() * most.powf(1.5) / (2.0 * r_mean * depth);
         return Err(refuse(
-            "walls.top.control.pressure",
+            format!("{at}.control.pressure"),
             format!("{pressure} Pa"),
             format!(
                 "at most {p_max:.3e} Pa for these grains (E* = {e_star:.3e} Pa): the load would press each contact in by about {:.3} of a radius (the contact law is meant for under {MAX_LOAD_OVERLAP}; the watchdog stops at {MAX_START_OVERLAP})",

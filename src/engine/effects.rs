@@ -108,7 +108,9 @@ impl Effects {
         let clamp = scene.model.limit_force;
         push("normal force clamp (Fn >= 0)", clamp, format!("declared: model.limit_force = {clamp}"), Some("force clamp on"));
         let g = scene.gravity;
-        push("gravity", g != [0.0, 0.0], format!("declared: gravity = [{}, {}]", g[0], g[1]), None);
+        let staged_g: Vec<String> = scene.stages.iter().enumerate().filter_map(|(k, st)| st.gravity.map(|g| format!("stages[{k}].gravity = [{}, {}]", g[0], g[1]))).collect();
+        let g_why = if staged_g.is_empty() { String::new() } else { format!("; {}", staged_g.join(", ")) };
+        push("gravity", scene.strongest_gravity() > 0.0, format!("declared: gravity = [{}, {}]{g_why}", g[0], g[1]), None);
         let gd = scene.model.general_damping;
         push("general damping (per grain)", gd.is_some(), gd.map_or("declared: model.general_damping absent".into(), |c| format!("declared: model.general_damping = {c}")), None);
         let wall_why = match &scene.walls {

@@ -4,7 +4,7 @@
 
 use std::time::{Duration, Instant};
 
-use crate::engine::world::{Stage, View, World};
+use crate::engine::world::{MotionChange, Stage, View, World};
 use crate::error::Error;
 use crate::physics::boundary::Boundary;
 use crate::physics::contact::ContactLaw;
@@ -72,6 +72,40 @@ impl<L: ContactLaw> Simulation<L> {
     }
 }
 
+impl<L: ContactLaw> Simulation<L> {
+    /// Change the walls' motion and control and gravity, between two steps. The grains'
+    /// pending half kick is given first. A wall's prescribed motion is a drive: the
+    /// kinetic energy the balance counts for it (a loaded wall's y motion) changes by what
+    /// the drive does, so that change is booked as the walls' work and the balance stays
+    /// closed across the change. The glued grains take the new velocity in the next drift.
+    pub fn change_motion(&mut self, c: &MotionChange) {
+        use crate::physics::walls::Control;
+        let w = &mut self.world;
+        crate::engine::integrate::settle(w);
+        for (wall, m) in w.walls.iter_mut().zip(&c.walls) {
+            let before = wall.kinetic();
+            if let Some(control) = m.control {
+                wall.control = control;
+                if control == Control::Fixed {
+                    wall.v.y = 0.0;
+                }
+            }
+            if let Some(vx) = m.velocity_x {
+                wall.v.x = vx;
+            }
+            if let Some(vy) = m.velocity_y {
+                wall.v.y = vy;
+            }
+            if w.energy {
+                w.ledger.walls += wall.kinetic() - before;
+            }
+        }
+        if let Some(g) = c.gravity {
+            w.gravity = g;
+        }
+    }
+}
+
 /// A running simulation behind one dynamic call per step, whatever its contact model.
 pub trait Engine: Send {
     fn step(&mut self) -> Result<(), Error>;
@@ -98,6 +132,8 @@ pub trait Engine: Send {
     fn model(&self) -> String;
     /// The full state check ([`World::health`]).
     fn health(&self) -> Result<(), Error>;
+    /// Change the walls' motion and gravity between two steps ([`Simulation::change_motion`]).
+    fn change_motion(&mut self, c: &MotionChange);
     /// A read-only view of the state, what observers and outputs read.
     fn view(&self) -> View<'_> {
         View { particles: self.particles(), walls: self.walls(), boundary: self.boundary(), time: self.time() }
@@ -152,5 +188,8 @@ impl<L: ContactLaw> Engine for Simulation<L> {
     }
     fn health(&self) -> Result<(), Error> {
         self.world.health()
+    }
+    fn change_motion(&mut self, c: &MotionChange) {
+        Simulation::change_motion(self, c)
     }
 }

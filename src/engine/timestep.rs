@@ -154,6 +154,23 @@ pub fn schedule(duration: f64, dt: f64, samples: u64) -> (u64, u64) {
     (total, (total / samples.max(1)).max(1))
 }
 
+/// The steps of each stage of a protocol of stage `durations` (s) at `dt`: the stage
+/// boundaries fall at the steps ceil(t / dt) of their times t (the stages' starts summed),
+/// so the stages add up to the steps of their total duration, as a run without stages
+/// takes. A stage shorter than a step may get none.
+pub fn stage_steps(durations: impl Iterator<Item = f64>, dt: f64) -> Vec<u64> {
+    let (mut t, mut at) = (0.0, 0u64);
+    durations
+        .map(|d| {
+            t += d;
+            let end = steps_of(t, dt) as u64;
+            let n = end.saturating_sub(at);
+            at = end;
+            n
+        })
+        .collect()
+}
+
 /// The steps a run of `duration` s takes at `dt` (at least one), as a float: NaN or
 /// infinite for a dt that is not finite and > 0 ([`step_count`] refuses those).
 fn steps_of(duration: f64, dt: f64) -> f64 {

@@ -178,6 +178,27 @@ impl<L: ContactLaw> World<L> {
     }
 }
 
+/// A change of the walls' motion and control and of gravity between two steps: what a
+/// protocol's stage sets at its start ([`crate::engine::simulation::Simulation::change_motion`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct MotionChange {
+    /// The bottom and top walls' changes.
+    pub walls: [WallMotion; 2],
+    /// Gravity from now on, m/s^2.
+    pub gravity: Option<Vec2>,
+}
+
+/// One wall's change; `None` leaves a field as it is.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct WallMotion {
+    /// Velocity in x, m/s.
+    pub velocity_x: Option<f64>,
+    /// Velocity in y under fixed control, m/s (a change to fixed control without it holds
+    /// the wall: 0).
+    pub velocity_y: Option<f64>,
+    pub control: Option<crate::physics::walls::Control>,
+}
+
 /// The grains `0..forces` have zero forces, `0..torques` zero torques ([`World::zeroed`]).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Zeroed {

@@ -41,11 +41,13 @@ impl Write for Counted {
 }
 
 pub struct CsvSeries {
-    w: ::csv::Writer<Counted>,
+    out: Counted,
     /// Where the rows go now.
     path: PathBuf,
     /// The name the file takes at [`CsvSeries::finish`], if not `path`.
     final_path: Option<PathBuf>,
+    /// The header has been written.
+    header: bool,
 }
 
 fn csv_error(path: &Path, e: ::csv::Error) -> Error {
@@ -73,26 +75,48 @@ impl CsvSeries {
 
     fn open(path: &Path, final_path: Option<PathBuf>) -> Result<Self, Error> {
         let file = File::create(path).map_err(|e| Error::io(path.display(), e))?;
-        let counted = Counted { file, bytes: 0, crc: crc32fast::Hasher::new() };
-        Ok(CsvSeries { w: ::csv::Writer::from_writer(counted), path: path.to_path_buf(), final_path })
+        let out = Counted { file, bytes: 0, crc: crc32fast::Hasher::new() };
+        Ok(CsvSeries { out, path: path.to_path_buf(), final_path, header: false })
     }
 
     /// Write a row; a row with a number that is not finite is refused (the run's checks
     /// stop a run before that, so this is the last line of defence: no output holds NaN).
     pub fn row<T: Serialize>(&mut self, row: &T) -> Result<(), Error> {
+        self.row_in("", row)
+    }
+
+    /// Write a row of a protocol's stage `stage`, named in a first column `stage` (none
+    /// when `stage` is empty: a run without stages). Stage names need no quoting (scene
+    /// validation admits letters, digits, spaces and `-_.`).
+    pub fn row_in<T: Serialize>(&mut self, stage: &str, row: &T) -> Result<(), Error> {
         if let Some(column) = crate::finite::non_finite_column(row) {
             return Err(Error::Other(format!("{}: a row whose {column} is not finite was not written", self.path.display())));
         }
-        self.w.serialize(row).map_err(|e| csv_error(&self.path, e))?;
-        self.w.flush().map_err(|e| Error::io(self.path.display(), e))
+        let mut w = ::csv::WriterBuilder::new().has_headers(!self.header).from_writer(Vec::new());
+        w.serialize(row).map_err(|e| csv_error(&self.path, e))?;
+        let mut bytes = w.into_inner().map_err(|e| Error::io(self.path.display(), e.into_error()))?;
+        if !stage.is_empty() {
+            let text = String::from_utf8(bytes).expect("CSV of numbers is UTF-8");
+            let mut out = String::with_capacity(text.len() + 2 * stage.len());
+            for (k, line) in text.split_inclusive('\n').enumerate() {
+                out.push_str(if k == 0 && !self.header { "stage," } else { stage });
+                if k > 0 || self.header {
+                    out.push(',');
+                }
+                out.push_str(line);
+            }
+            bytes = out.into_bytes();
+        }
+        self.header = true;
+        self.out.write_all(&bytes).and_then(|()| self.out.flush()).map_err(|e| Error::io(self.path.display(), e))
     }
 
     /// Flush, rename a staged series to its name, and return its size and CRC-32.
-    pub fn finish(self) -> Result<(u64, u32), Error> {
-        let counted = self.w.into_inner().map_err(|e| Error::io(self.path.display(), e.into_error()))?;
+    pub fn finish(mut self) -> Result<(u64, u32), Error> {
+        self.out.flush().map_err(|e| Error::io(self.path.display(), e))?;
         if let Some(to) = &self.final_path {
             std::fs::rename(&self.path, to).map_err(|e| Error::io(to.display(), e))?;
         }
-        Ok((counted.bytes, counted.crc.finalize()))
+        Ok((self.out.bytes, self.out.crc.finalize()))
     }
 }

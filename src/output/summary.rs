@@ -17,6 +17,24 @@ pub struct StageTime {
     pub share: f64,
 }
 
+/// One stage of a protocol in the summary.
+#[derive(Clone, Debug, Serialize)]
+pub struct StageSummary {
+    pub name: String,
+    /// Simulated time at the stage's start, s.
+    pub start_s: f64,
+    /// ... and at its last row, s.
+    pub end_s: f64,
+    /// Steps the stage takes.
+    pub steps: u64,
+    /// Rows of the wall series it wrote.
+    pub rows: usize,
+    /// Whether its wall stresses are averaged (the scene's `stages[k].average`).
+    pub averaged: bool,
+    /// Its wall stresses' time averages (analysis shear, averaged, at least 4 rows).
+    pub shear: Option<ShearSummary>,
+}
+
 /// A run's summary (`summary.json`, also printed on stdout).
 #[derive(Clone, Debug, Serialize)]
 pub struct Summary {
@@ -33,7 +51,12 @@ pub struct Summary {
     pub particle_steps_per_s: f64,
     pub energy: Option<EnergySummary>,
     pub impact: Option<ImpactSummary>,
+    /// The wall stresses' time averages: of the run, or of a protocol's last averaged
+    /// stage (each stage's are in `stages`).
     pub shear: Option<ShearSummary>,
+    /// A protocol's stages, one block each (none for a scene without stages).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub stages: Vec<StageSummary>,
     pub stage_timing: Vec<StageTime>,
     /// What produced the run: grainlab's version and commit, the command line, the CPU,
     /// the threads, the start and end ([`crate::output::provenance`]).

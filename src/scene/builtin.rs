@@ -11,6 +11,7 @@ pub const BUILTIN: &[(&str, &str)] = &[
     ("collision", "two glass beads head-on at 1 m/s, e = 0.5: the seed's 1D model with energy monitoring"),
     ("oblique", "a glass bead hitting a flat glass wall at 45 degrees and 1 m/s, e = 0.9, mu = 0.5"),
     ("shear", "the seed's experiment: ~1000 polydisperse glass beads, periodic x, rough walls at +-0.5 m/s under 100 kPa"),
+    ("protocol", "the shear cell as a study runs it, in four stages: compress to 100 kPa, relax, shear at +-0.5 m/s, shear at +-2 m/s"),
 ];
 
 fn glass(restitution: f64) -> Material {
@@ -50,6 +51,7 @@ pub fn head_on(material: Material, r: f64, v: f64, steps_per_contact: f64) -> Sc
         neighbor: NeighborSpec::default(),
         output: OutputSpec { samples: 200, frames: 0, energy: true },
         analysis: Analysis::Impact,
+        stages: Vec::new(),
     }
 }
 
@@ -66,8 +68,8 @@ pub fn oblique(material: Material, r: f64, v: f64, angle_deg: f64, tangential: T
     s.description = BUILTIN[1].1.into();
     s.grains = Grains::List(vec![GrainSpec { x: [0.0, r + gap], v: [v * a.sin(), -v * a.cos()], omega: 0.0, r, material: 0 }]);
     s.walls = Some(WallsSpec {
-        bottom: WallSpec { y: Some(0.0), velocity_x: 0.0, surface: SurfaceSpec::Flat, control: ControlSpec::Fixed, mass: None, material: 0 },
-        top: WallSpec { y: Some(1.0), velocity_x: 0.0, surface: SurfaceSpec::Flat, control: ControlSpec::Fixed, mass: None, material: 0 },
+        bottom: WallSpec { y: Some(0.0), velocity_x: 0.0, velocity_y: 0.0, surface: SurfaceSpec::Flat, control: ControlSpec::Fixed, mass: None, material: 0 },
+        top: WallSpec { y: Some(1.0), velocity_x: 0.0, velocity_y: 0.0, surface: SurfaceSpec::Flat, control: ControlSpec::Fixed, mass: None, material: 0 },
         thickness: None,
     });
     s.model.tangential = tangential;
@@ -113,8 +115,8 @@ pub fn shear() -> Scene {
             packing_fraction: 0.75,
         }),
         walls: Some(WallsSpec {
-            bottom: WallSpec { y: Some(0.0), velocity_x: -v, surface: SurfaceSpec::Rough { radius: 0.5e-3 }, control: ControlSpec::Fixed, mass: None, material: 0 },
-            top: WallSpec { y: None, velocity_x: v, surface: SurfaceSpec::Rough { radius: 0.5e-3 }, control: ControlSpec::Pressure(p), mass: None, material: 0 },
+            bottom: WallSpec { y: Some(0.0), velocity_x: -v, velocity_y: 0.0, surface: SurfaceSpec::Rough { radius: 0.5e-3 }, control: ControlSpec::Fixed, mass: None, material: 0 },
+            top: WallSpec { y: None, velocity_x: v, velocity_y: 0.0, surface: SurfaceSpec::Rough { radius: 0.5e-3 }, control: ControlSpec::Pressure(p), mass: None, material: 0 },
             thickness: None,
         }),
         gravity: [0.0, 0.0],
@@ -124,7 +126,39 @@ pub fn shear() -> Scene {
         neighbor: NeighborSpec::default(),
         output: OutputSpec { samples: 400, frames: 20, energy: true },
         analysis: Analysis::Shear,
+        stages: Vec::new(),
     }
+}
+
+/// The shear cell in a four-stage protocol: the packing is compressed under 100 kPa with
+/// the walls at rest, relaxes under the load, is sheared with the walls at +-0.5 m/s and
+/// then at +-2 m/s. The time step is set for contacts at 2 m/s, the fastest stage's
+/// wall speed; the first two stages are not averaged (no steady shear).
+pub fn protocol() -> Scene {
+    let mut s = shear();
+    s.name = "protocol".into();
+    s.description = BUILTIN[3].1.into();
+    let walls = s.walls.as_mut().expect("the shear cell has walls");
+    walls.bottom.velocity_x = 0.0;
+    walls.top.velocity_x = 0.0;
+    s.time_step.rule = TimeStepRule::StepsPerContact { steps: 50.0, impact_speed: 2.0 };
+    let shear_at = |name: &str, v: f64, duration: f64| StageSpec {
+        name: name.into(),
+        duration,
+        walls: StageWalls { bottom: WallChange { velocity_x: Some(-v), ..WallChange::default() }, top: WallChange { velocity_x: Some(v), ..WallChange::default() } },
+        average: true,
+        ..StageSpec::default()
+    };
+    s.stages = vec![
+        StageSpec { name: "compress".into(), duration: 0.01, average: false, ..StageSpec::default() },
+        StageSpec { name: "relax".into(), duration: 0.005, average: false, ..StageSpec::default() },
+        shear_at("shear 0.5", 0.5, 0.03),
+        shear_at("shear 2", 2.0, 0.03),
+    ];
+    s.duration = 0.075;
+    s.output.samples = 600;
+    s.output.frames = 30;
+    s
 }
 
 /// The seed's shear cell with `count` grains over a periodic length `length`, m: the
@@ -175,6 +209,7 @@ pub fn builtin(name: &str) -> Option<Scene> {
         "collision" => Some(head_on(glass(0.5), 1e-3, 1.0, 200.0)),
         "oblique" => Some(oblique(glass(0.9), 1e-3, 1.0, 45.0, TangentialSpec::TotalDisplacement, 200.0)),
         "shear" => Some(shear()),
+        "protocol" => Some(protocol()),
         _ => None,
     }
 }

@@ -36,6 +36,10 @@ pub const MAX_STEPS: f64 = 1e12;
 /// folder's manifest, whose sizes grow with the frames.
 pub const MAX_FRAMES: u64 = 10_000;
 
+/// Most stages a protocol may have: each is a row of the summary and a block of the
+/// exported decks.
+pub const MAX_STAGES: usize = 1000;
+
 /// The most points an impact's force-overlap curve keeps: a million steps in contact (an
 /// impact at 200 steps per contact time takes about 200).
 pub const MAX_CURVE_POINTS: usize = 1_000_000;

@@ -39,7 +39,9 @@ pub struct Scene {
     #[serde(default)]
     pub model: ModelSpec,
     pub time_step: TimeStepSpec,
-    /// Simulated time, s.
+    /// Simulated time, s. With `stages` it may be left out (it is then their sum) or
+    /// given as their sum.
+    #[serde(default)]
     pub duration: f64,
     #[serde(default)]
     pub neighbor: NeighborSpec,
@@ -48,6 +50,74 @@ pub struct Scene {
     /// What the summary reports. Default: none.
     #[serde(default)]
     pub analysis: Analysis,
+    /// A protocol: stages run one after another, each changing the walls' motion and
+    /// control, gravity, the output rates and the averaging at its start. Default: none
+    /// (the scene runs as given for `duration`).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub stages: Vec<StageSpec>,
+}
+
+/// One stage of a protocol: what changes at its start and how long it runs. What it does
+/// not name stays as the scene (or the stage before) left it.
+#[derive(Clone, Debug, Default, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct StageSpec {
+    /// Name, written in the time series' `stage` column and the summary. Letters, digits,
+    /// spaces and `-_.`, at most 64 characters. Default `stage K` (K counts from 1).
+    #[serde(default)]
+    pub name: String,
+    /// Simulated time of the stage, s (> 0).
+    pub duration: f64,
+    /// The walls' motion and control from the stage's start. Default: unchanged.
+    #[serde(default)]
+    pub walls: StageWalls,
+    /// Gravity from the stage's start, m/s^2. Default: unchanged.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gravity: Option<[f64; 2]>,
+    /// Rows of the time series over the stage (>= 1). Default: the scene's
+    /// `output.samples` shared out by duration.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub samples: Option<u64>,
+    /// ParaView frames over the stage. Default: the scene's `output.frames` shared out by
+    /// duration.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub frames: Option<u64>,
+    /// Whether the summary averages the stage's wall stresses (analysis `shear`): a
+    /// compression or relaxation stage is not a steady state. Default true.
+    #[serde(default = "yes")]
+    pub average: bool,
+}
+
+/// The walls' changes at a stage's start.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct StageWalls {
+    #[serde(default, skip_serializing_if = "WallChange::is_none")]
+    pub bottom: WallChange,
+    #[serde(default, skip_serializing_if = "WallChange::is_none")]
+    pub top: WallChange,
+}
+
+/// One wall's change at a stage's start; each field left out stays as it was.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct WallChange {
+    /// Velocity in x, m/s.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub velocity_x: Option<f64>,
+    /// Velocity in y of a wall under `fixed` control (a prescribed motion), m/s. A wall
+    /// that changes to `fixed` without it is held (0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub velocity_y: Option<f64>,
+    /// `"fixed"` (prescribed motion) or `{"pressure": p}` (Pa, top wall only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub control: Option<ControlSpec>,
+}
+
+impl WallChange {
+    pub fn is_none(&self) -> bool {
+        *self == WallChange::default()
+    }
 }
 
 fn default_materials() -> Vec<Material> {
@@ -180,6 +250,10 @@ pub struct WallSpec {
     /// Velocity in x, m/s. Default 0.
     #[serde(default)]
     pub velocity_x: f64,
+    /// Velocity in y, m/s, of a wall under `fixed` control (a prescribed motion, e.g. a
+    /// compression at constant rate). Default 0 (held).
+    #[serde(default)]
+    pub velocity_y: f64,
     /// `"flat"` (default) or `{"rough": {"radius": r}}`.
     #[serde(default)]
     pub surface: SurfaceSpec,

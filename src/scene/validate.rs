@@ -4,7 +4,7 @@
 
 use crate::error::{Error, check};
 use crate::physics::dim::GrainShape;
-use crate::scene::limits::{MAX_FRAMES, MAX_MATERIALS};
+use crate::scene::limits::{MAX_FRAMES, MAX_MATERIALS, MAX_STAGES};
 use crate::scene::spec::*;
 
 fn finite_pos(v: f64) -> bool {
@@ -28,6 +28,11 @@ impl Scene {
             Error::Parse { path, what }
         })?;
         de.end().map_err(|e| Error::Parse { path: ".".into(), what: format!("{e} (after the scene object)") })?;
+        let mut s = s;
+        // A protocol's duration left out is its stages' sum.
+        if !s.stages.is_empty() && s.duration == 0.0 {
+            s.duration = s.stages.iter().map(|st| st.duration).sum();
+        }
         s.validate()?;
         Ok(s)
     }
@@ -96,6 +101,8 @@ impl Scene {
                     check(y.is_finite(), &at, "y", y, "finite m")?;
                 }
                 check(s.velocity_x.is_finite(), &at, "velocity_x", s.velocity_x, "finite m/s")?;
+                check(s.velocity_y.is_finite(), &at, "velocity_y", s.velocity_y, "finite m/s")?;
+                check(s.velocity_y == 0.0 || s.control == ControlSpec::Fixed, &at, "velocity_y", s.velocity_y, "0 under pressure control (the load moves the wall in y)")?;
                 check(mat_ok(s.material), &at, "material", s.material, &mats)?;
                 if let SurfaceSpec::Rough { radius } = s.surface {
                     check(finite_pos(radius), &format!("{at}.surface.rough"), "radius", radius, "> 0 m")?;
@@ -159,7 +166,164 @@ impl Scene {
         if self.analysis == Analysis::Shear {
             check(self.walls.is_some() && self.domain.periodic_x.is_some(), "", "analysis", "shear", "a scene with walls and periodic_x")?;
         }
+        self.validate_stages()
+    }
+
+    /// A protocol's stages: each on its own, and each wall's control as the stages
+    /// before it leave it (a prescribed y velocity needs `fixed` control).
+    fn validate_stages(&self) -> Result<(), Error> {
+        let stages = &self.stages;
+        if stages.is_empty() {
+            return Ok(());
+        }
+        check(stages.len() <= MAX_STAGES, "", "stages", format!("{} stages", stages.len()), &format!("at most {MAX_STAGES}"))?;
+        check(self.analysis != Analysis::Impact, "", "stages", format!("{} stages", stages.len()), "none with analysis impact (an impact ends at separation, not with a protocol)")?;
+        let mut pressure = self.walls.as_ref().map(|w| [w.bottom.control != ControlSpec::Fixed, w.top.control != ControlSpec::Fixed]);
+        let mut names = std::collections::HashSet::new();
+        let mut frames = 0u64;
+        for (k, st) in stages.iter().enumerate() {
+            let at = format!("stages[{k}]");
+            let name_ok = st.name.len() <= 64 && st.name.chars().all(|c| c.is_ascii_alphanumeric() || " -_.".contains(c)) && st.name.trim() == st.name;
+            check(name_ok, &at, "name", format!("{:?}", st.name), "letters, digits, spaces and -_. (at most 64 characters, no space at either end)")?;
+            let name = self.stage_name(k);
+            check(names.insert(name.clone()), &at, "name", format!("{name:?}"), "a name no other stage has")?;
+            check(finite_pos(st.duration), &at, "duration", st.duration, "> 0 s")?;
+            if let Some(g) = st.gravity {
+                check(g.iter().all(|g| g.is_finite()), &at, "gravity", format!("{g:?}"), "finite m/s^2")?;
+            }
+            if let Some(n) = st.samples {
+                check(n >= 1, &at, "samples", n, ">= 1")?;
+            }
+            frames = frames.saturating_add(st.frames.unwrap_or(0));
+            for (w, (name, c)) in [("bottom", &st.walls.bottom), ("top", &st.walls.top)].into_iter().enumerate() {
+                let at = format!("{at}.walls.{name}");
+                let Some(loaded) = pressure.as_mut() else {
+                    check(c.is_none(), &at.replace(&format!(".walls.{name}"), ""), "walls", name, "no wall changes: the scene has no walls")?;
+                    continue;
+                };
+                if let Some(v) = c.velocity_x {
+                    check(v.is_finite(), &at, "velocity_x", v, "finite m/s")?;
+                }
+                match &c.control {
+                    Some(ControlSpec::Pressure(p)) => {
+                        check(name == "top", &at, "control", "pressure", "fixed (only the top wall carries a load)")?;
+                        check(finite_pos(*p), &at, "control.pressure", *p, "> 0 Pa")?;
+                        loaded[w] = true;
+                    }
+                    Some(ControlSpec::Fixed) => loaded[w] = false,
+                    None => {}
+                }
+                if let Some(v) = c.velocity_y {
+                    check(v.is_finite(), &at, "velocity_y", v, "finite m/s")?;
+                    check(!loaded[w], &at, "velocity_y", v, "none while the wall is under pressure control (its load moves it in y)")?;
+                }
+            }
+        }
+        check(frames <= MAX_FRAMES, "", "stages", format!("{frames} frames in all"), &format!("at most {MAX_FRAMES} frames"))?;
+        let sum: f64 = stages.iter().map(|s| s.duration).sum();
+        check((self.duration - sum).abs() <= 1e-9 * sum, "", "duration", self.duration, &format!("the stages' sum, {sum} s (or leave it out)"))?;
         Ok(())
+    }
+
+/// The stages in one line, for `explain`: each with its duration and what it changes.
+    pub fn describe_stages(&self) -> Option<String> {
+            let scene = self;
+        if scene.stages.is_empty() {
+            return None;
+        }
+        let parts: Vec<String> = scene
+            .stages
+            .iter()
+            .enumerate()
+            .map(|(k, st)| {
+                let mut what = Vec::new();
+                for (name, c) in [("bottom", &st.walls.bottom), ("top", &st.walls.top)] {
+                    let mut w = Vec::new();
+                    if let Some(v) = c.velocity_x {
+                        w.push(format!("vx {v} m/s"));
+                    }
+                    if let Some(v) = c.velocity_y {
+                        w.push(format!("vy {v} m/s"));
+                    }
+                    match &c.control {
+                        Some(ControlSpec::Fixed) => w.push("fixed".into()),
+                        Some(ControlSpec::Pressure(p)) => w.push(format!("pressure {p} Pa")),
+                        None => {}
+                    }
+                    if !w.is_empty() {
+                        what.push(format!("{name} {}", w.join(", ")));
+                    }
+                }
+                if let Some(g) = st.gravity {
+                    what.push(format!("gravity [{}, {}] m/s^2", g[0], g[1]));
+                }
+                if !st.average {
+                    what.push("not averaged".into());
+                }
+                let what = if what.is_empty() { String::new() } else { format!(": {}", what.join("; ")) };
+                format!("{} ({} s{what})", scene.stage_name(k), st.duration)
+            })
+            .collect();
+        Some(format!("stages: {}", parts.join(" -> ")))
+    }
+
+    /// The name of stage `k`: its own, or `stage K` (K = k + 1).
+    pub fn stage_name(&self, k: usize) -> String {
+        match self.stages.get(k) {
+            Some(s) if !s.name.is_empty() => s.name.clone(),
+            _ => format!("stage {}", k + 1),
+        }
+    }
+
+    /// The scene cut to its first `duration` s: the stages that begin before it, the last
+    /// one shortened (a scene without stages only takes the new duration).
+    pub fn truncated(&self, duration: f64) -> Scene {
+        let mut s = self.clone();
+        s.duration = duration;
+        if !s.stages.is_empty() {
+            let mut start = 0.0;
+            let mut kept = Vec::new();
+            for (k, st) in self.stages.iter().enumerate() {
+                if start >= duration && !kept.is_empty() {
+                    break;
+                }
+                let mut st = st.clone();
+                st.name = self.stage_name(k);
+                st.duration = st.duration.min(duration - start);
+                start += self.stages[k].duration;
+                kept.push(st);
+            }
+            s.duration = kept.iter().map(|st| st.duration).sum();
+            s.stages = kept;
+        }
+        s
+    }
+
+    /// The fastest wall speed of the scene and of any of its stages, m/s.
+    pub fn fastest_wall(&self) -> f64 {
+        let Some(w) = &self.walls else { return 0.0 };
+        let mut v = [(w.bottom.velocity_x, w.bottom.velocity_y), (w.top.velocity_x, w.top.velocity_y)];
+        let mut most = v.iter().map(|(x, y)| x.hypot(*y)).fold(0.0, f64::max);
+        for st in &self.stages {
+            for (k, c) in [&st.walls.bottom, &st.walls.top].into_iter().enumerate() {
+                if let Some(x) = c.velocity_x {
+                    v[k].0 = x;
+                }
+                if c.control.is_some() {
+                    v[k].1 = 0.0;
+                }
+                if let Some(y) = c.velocity_y {
+                    v[k].1 = y;
+                }
+            }
+            most = v.iter().map(|(x, y)| x.hypot(*y)).fold(most, f64::max);
+        }
+        most
+    }
+
+    /// The strongest gravity of the scene and of any of its stages, m/s^2.
+    pub fn strongest_gravity(&self) -> f64 {
+        self.stages.iter().filter_map(|s| s.gravity).chain([self.gravity]).map(|g| g[0].hypot(g[1])).fold(0.0, f64::max)
     }
 
     /// The lower edge of a packing's region: its `y_min`, else the bottom wall's surface.

@@ -1,4 +1,5 @@
-//! Studies: a scene built and run with its observers and outputs ([`run`]), over time
+//! Studies: a scene built and run with its observers and outputs ([`run`]), stage by
+//! stage when it is a protocol ([`protocol`]), over time
 //! steps and model variants ([`sweep`]), over packing seeds ([`ensemble`]), and the accuracy calibration that resolves an
 //! accuracy rule into a time step before the engine is built ([`accuracy`]).
 //! May use: everything below it (`output`, `observe`, `engine`, `scene`, `kernels`,
@@ -6,6 +7,7 @@
 
 pub mod accuracy;
 pub mod ensemble;
+pub mod protocol;
 pub mod run;
 pub mod sweep;
 

@@ -11,7 +11,9 @@ use indicatif::{ProgressBar, ProgressStyle};
 
 use crate::engine::build::Built;
 use crate::engine::simulation::Engine;
-use crate::engine::timestep::{schedule, step_count};
+use crate::engine::timestep::step_count;
+use crate::engine::world::MotionChange;
+use crate::study::protocol::{Phase, phases};
 use crate::error::Error;
 use crate::observe::energy::energy_summary;
 use crate::observe::impact::ImpactObserver;
@@ -19,7 +21,7 @@ use crate::observe::stress::{ShearSummary, WallAverager, WallRow, stress_estimat
 use crate::output::csv::CsvSeries;
 use crate::output::folder::OutFolder;
 use crate::output::provenance::{Provenance, RESOLVED_SCENE, resolved};
-use crate::output::summary::{StageTime, Summary};
+use crate::output::summary::{StageSummary, StageTime, Summary};
 use crate::output::vtk::VtkSeries;
 use crate::physics::energy::EnergyRow;
 use crate::scene::{Analysis, Scene};
@@ -108,24 +110,32 @@ pub fn run_built(scene: &Scene, built: Built, opts: &RunOptions) -> Result<Summa
 pub fn run_report(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<RunReport, Error> {
     let duration = opts.duration.unwrap_or(scene.duration);
     let dt = built.time_step.dt_s;
-    // The build checked the scene's duration; an override is checked here.
+    // The build checked the scene's duration; an override is checked here, and cuts a
+    // protocol short.
     step_count(duration, dt, if opts.duration.is_some() { "--duration" } else { "duration" })?;
-    let (total, sample_every) = schedule(duration, dt, scene.output.samples);
-    let frame_every = if scene.output.frames > 0 { Some((total / scene.output.frames).max(1)) } else { None };
+    let cut;
+    let scene = if opts.duration.is_some() {
+        cut = scene.truncated(duration);
+        &cut
+    } else {
+        scene
+    };
+    let phases = phases(scene, dt, built.length, built.depth)?;
+    let total = phases.last().map_or(0, Phase::last);
     let energy_on = scene.output.energy;
     let started = std::time::SystemTime::now();
     let mut outputs = Outputs { folder: None, energy: None, walls: None, vtk: None };
     if let Some(dir) = &opts.out {
         let mut folder = OutFolder::claim(dir, opts.overwrite, &format!("run {}", scene.name))?;
         // The scene as it runs: the folder alone repeats the run.
-        folder.write(RESOLVED_SCENE, (serde_json::to_string_pretty(&resolved(scene, duration)).expect("serialisable") + "\n").as_bytes())?;
+        folder.write(RESOLVED_SCENE, (serde_json::to_string_pretty(&resolved(scene, scene.duration)).expect("serialisable") + "\n").as_bytes())?;
         if energy_on {
             outputs.energy = Some(folder.series("energy.csv")?);
         }
         if !built.engine.walls().is_empty() {
             outputs.walls = Some(folder.series("walls.csv")?);
         }
-        if frame_every.is_some() {
+        if phases.iter().any(|p| p.frame_every.is_some()) {
             outputs.vtk = Some(VtkSeries::new(&mut folder)?);
         }
         outputs.folder = Some(folder);
@@ -138,33 +148,36 @@ pub fn run_report(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<
     }
     let mut walls_avg = WallAverager::default();
     let mut wall_rows: Vec<WallRow> = Vec::new();
+    // The rows each stage ended at (an index into `wall_rows`), as the stages end.
+    let mut stage_ends: Vec<usize> = Vec::new();
     let mut max_res: f64 = 0.0;
     let mut energy_rows = 0usize;
     // The last row recorded (of a state that passed its checks): the summary's, so that a
     // run stopped on a state gone wrong reports the last one that was not.
     let mut last_row: Option<EnergyRow> = None;
-    let mut record_energy = |e: &dyn Engine, out: &mut Outputs| -> Result<(), Error> {
+    let mut record_energy = |e: &dyn Engine, out: &mut Outputs, stage: &str| -> Result<(), Error> {
         if energy_on {
             let row = e.energy_row();
             max_res = max_res.max(row.residual_j.abs() / row.put_in().max(f64::MIN_POSITIVE));
             energy_rows += 1;
             last_row = Some(row);
             if let Some(w) = out.energy.as_mut() {
-                w.row(&row)?;
+                w.row_in(stage, &row)?;
             }
         }
         Ok(())
     };
     // Why the run stops early, if it does, and the first output that failed besides.
-    let mut error: Option<Error> = record_energy(e, &mut outputs).and_then(|()| outputs.frame(e)).err();
+    let first_stage = phases.first().map_or("", |p| p.name.as_str());
+    let mut error: Option<Error> = record_energy(e, &mut outputs, first_stage).and_then(|()| outputs.frame(e)).err();
     let mut write_error: Option<Error> = None;
     let mut unwritten: Vec<String> = Vec::new();
     // An output that cannot be written stops the run; what it computed is summarised.
     macro_rules! or_stop {
-        ($written:expr) => {
+        ($run:lifetime, $written:expr) => {
             if let Err(err) = $written {
                 error = Some(err);
-                break;
+                break $run;
             }
         };
     }
@@ -190,73 +203,86 @@ pub fn run_report(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<
         None
     };
     let t0 = Instant::now();
-    let steps = if error.is_none() { total } else { 0 };
-    for k in 1..=steps {
-        // A stop request makes this step the last, sampled like the last of the run.
-        let stopping = stop.is_some_and(|s| s.load(Ordering::Relaxed));
-        // Whether anything below looks at the grains after this step: else the step's
-        // final half kick is left to the next one's drift.
-        let look = stopping || impact.is_some() || k % sample_every == 0 || k == total || frame_every.is_some_and(|every| k % every == 0);
-        if let Err(err) = e.advance(look) {
-            error = Some(err);
-            break;
+    let phases_run: &[Phase] = if error.is_none() { &phases } else { &[] };
+    'run: for phase in phases_run {
+        let stage = phase.name.as_str();
+        if phase.change != MotionChange::default() {
+            e.change_motion(&phase.change);
         }
-        if let Some(o) = impact.as_mut() {
-            // The observer records every step (its curve is an output): every step's state
-            // is checked first, cheap for the one or two grains of an impact.
-            if let Err(err) = e.health() {
+        let shown = if stage.is_empty() { scene.name.clone() } else { format!("{} [{stage}]", scene.name) };
+        for j in 1..=phase.steps {
+            let k = phase.first + j;
+            // A stop request makes this step the last, sampled like the last of the run.
+            let stopping = stop.is_some_and(|s| s.load(Ordering::Relaxed));
+            let sample = j % phase.sample_every == 0 || j == phase.steps || stopping;
+            let frame = phase.frame_every.is_some_and(|every| j % every == 0);
+            // Whether anything below looks at the grains after this step: else the step's
+            // final half kick is left to the next one's drift.
+            let look = sample || frame || impact.is_some();
+            if let Err(err) = e.advance(look) {
                 error = Some(err);
-                break;
+                break 'run;
             }
-            o.observe(&e.view());
-        }
-        walls_avg.accumulate(&e.view());
-        let sample = k % sample_every == 0 || k == total || stopping;
-        let frame = frame_every.is_some_and(|every| k % every == 0);
-        // Nothing is written of a state that failed its check: outputs hold only finite
-        // numbers, and the stop is diagnosed in the summary.
-        if (sample || frame)
-            && let Err(err) = e.health()
-        {
-            error = Some(err);
-            break;
-        }
-        if sample {
-            or_stop!(record_energy(e, &mut outputs));
-            if let Some(row) = walls_avg.row(&e.view(), built.length, built.depth) {
-                if let Some(w) = outputs.walls.as_mut() {
-                    or_stop!(w.row(&row));
+            if let Some(o) = impact.as_mut() {
+                // The observer records every step (its curve is an output): every step's
+                // state is checked first, cheap for the one or two grains of an impact.
+                if let Err(err) = e.health() {
+                    error = Some(err);
+                    break 'run;
                 }
-                wall_rows.push(row);
+                o.observe(&e.view());
+            }
+            walls_avg.accumulate(&e.view());
+            // Nothing is written of a state that failed its check: outputs hold only
+            // finite numbers, and the stop is diagnosed in the summary.
+            if (sample || frame)
+                && let Err(err) = e.health()
+            {
+                error = Some(err);
+                break 'run;
+            }
+            if sample {
+                or_stop!('run, record_energy(e, &mut outputs, stage));
+                if let Some(row) = walls_avg.row(&e.view(), built.length, built.depth) {
+                    if let Some(w) = outputs.walls.as_mut() {
+                        or_stop!('run, w.row_in(stage, &row));
+                    }
+                    wall_rows.push(row);
+                }
+            }
+            if frame {
+                or_stop!('run, outputs.frame(e));
+            }
+            if k % 1000 == 0
+                && let Some(b) = &bar
+            {
+                b.set_position(k);
+                b.set_message(progress_message(&shown, e.time(), wall_rows.last()));
+            }
+            // Without a terminal, a line at each tenth of the run.
+            if lines && k * 10 >= next_line * total {
+                next_line = k * 10 / total + 1;
+                let secs = t0.elapsed().as_secs_f64();
+                let eta = secs * (total - k) as f64 / k as f64;
+                let _ = writeln!(std::io::stderr().lock(), "{}: {}% of {} steps, {secs:.1} s, eta {eta:.1} s", progress_message(&shown, e.time(), wall_rows.last()), 100 * k / total, total);
+            }
+            if stopping {
+                error = Some(Error::Interrupted { step: e.steps(), time: e.time() });
+                break 'run;
+            }
+            if impact.as_ref().is_some_and(|o| o.finished()) {
+                match e.health() {
+                    Err(err) => error = Some(err),
+                    Ok(()) => or_note!("energy.csv", record_energy(e, &mut outputs, stage)),
+                }
+                break 'run;
             }
         }
-        if frame {
-            or_stop!(outputs.frame(e));
-        }
-        if k % 1000 == 0
-            && let Some(b) = &bar
-        {
-            b.set_position(k);
-            b.set_message(progress_message(&scene.name, e.time(), wall_rows.last()));
-        }
-        // Without a terminal, a line at each tenth of the run.
-        if lines && k * 10 >= next_line * total {
-            next_line = k * 10 / total + 1;
-            let secs = t0.elapsed().as_secs_f64();
-            let eta = secs * (total - k) as f64 / k as f64;
-            let _ = writeln!(std::io::stderr().lock(), "{}: {}% of {} steps, {secs:.1} s, eta {eta:.1} s", progress_message(&scene.name, e.time(), wall_rows.last()), 100 * k / total, total);
-        }
-        if stopping {
-            error = Some(Error::Interrupted { step: e.steps(), time: e.time() });
-            break;
-        }
-        if impact.as_ref().is_some_and(|o| o.finished()) {
-            match e.health() {
-                Err(err) => error = Some(err),
-                Ok(()) => or_note!("energy.csv", record_energy(e, &mut outputs)),
-            }
-            break;
-        }
+        stage_ends.push(wall_rows.len());
+    }
+    // A stage cut short by a stop ends at the last row.
+    if stage_ends.len() < phases.len() {
+        stage_ends.push(wall_rows.len());
     }
     let wall_time = t0.elapsed().as_secs_f64();
     if let Some(b) = bar {
@@ -265,7 +291,28 @@ pub fn run_report(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<
     let timings = e.timings();
     let total_t: f64 = timings.iter().map(|t| t.1.as_secs_f64()).sum::<f64>().max(f64::MIN_POSITIVE);
     let stage_timing = timings.iter().map(|(s, d)| StageTime { stage: s.clone(), seconds: d.as_secs_f64(), share: d.as_secs_f64() / total_t }).collect();
-    let shear = (scene.analysis == Analysis::Shear && wall_rows.len() >= 4).then(|| shear_summary(&wall_rows, e.particles(), built.length));
+    let mut stages = Vec::new();
+    let mut shear = None;
+    let mut from = 0;
+    for (phase, &to) in phases.iter().zip(&stage_ends) {
+        let rows = &wall_rows[from..to];
+        let averaged = (scene.analysis == Analysis::Shear && phase.average && rows.len() >= 4).then(|| shear_summary(rows, e.particles(), built.length));
+        if averaged.is_some() {
+            shear.clone_from(&averaged);
+        }
+        if !phase.name.is_empty() {
+            stages.push(StageSummary {
+                name: phase.name.clone(),
+                start_s: phase.first as f64 * dt,
+                end_s: rows.last().map_or(phase.first as f64 * dt, |r| r.time_s),
+                steps: phase.steps,
+                rows: rows.len(),
+                averaged: phase.average,
+                shear: averaged,
+            });
+        }
+        from = to;
+    }
     let mut provenance = Provenance::new(started, e.threads(), &opts.command, opts.out.as_ref().map(|_| RESOLVED_SCENE.to_string()));
     provenance.end();
     let p = e.particles();
@@ -289,6 +336,7 @@ pub fn run_report(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<
         energy: energy_on.then(|| energy_summary(last_row.unwrap_or_else(|| e.energy_row()), max_res, dt)),
         impact: impact.as_ref().and_then(|o| o.summary()),
         shear,
+        stages,
         stage_timing,
         provenance,
     };
