@@ -436,6 +436,40 @@ fn bases(dir: &Path) -> Vec<Base> {
     let mut s = shear.clone();
     s.walls.as_mut().unwrap().top.surface = SurfaceSpec::Flat;
     out.push(variant("shear-flat-top", &s, "shear", "walls.top.surface", &["walls.top.surface"]));
+
+    // A protocol: every stage field set, the walls at rest at the start. Its JSON leaves
+    // the duration out (the stages' sum), so that a stage's duration may change.
+    let mut s = shear.clone();
+    let w = s.walls.as_mut().unwrap();
+    w.bottom.velocity_x = 0.0;
+    w.top.velocity_x = 0.0;
+    let first = StageSpec {
+        name: "held".into(),
+        duration: 2e-5,
+        walls: StageWalls {
+            bottom: WallChange { velocity_x: Some(-0.5), velocity_y: Some(0.0), control: Some(ControlSpec::Fixed) },
+            top: WallChange { velocity_x: Some(0.5), velocity_y: Some(1e-3), control: Some(ControlSpec::Fixed) },
+        },
+        gravity: Some([0.0, 0.0]),
+        samples: Some(3),
+        frames: Some(1),
+        average: false,
+    };
+    let loaded = |control| StageSpec { name: "loaded".into(), duration: 2e-5, walls: StageWalls { top: WallChange { control: Some(control), ..WallChange::default() }, ..StageWalls::default() }, ..StageSpec::default() };
+    s.stages = vec![first.clone(), loaded(ControlSpec::Pressure(1e5))];
+    let staged = |s: &Scene| {
+        let mut v = json_of(s);
+        v.as_object_mut().unwrap().remove("duration");
+        v
+    };
+    out.push(Base { name: "shear-staged", scene: staged(&s), only: &["stages"], variant_of: None });
+    s.stages = vec![first.clone(), loaded(ControlSpec::Fixed)];
+    out.push(Base { name: "shear-staged-held", scene: staged(&s), only: &[], variant_of: Some(("shear-staged", "stages[].walls.top.control")) });
+    // A protocol beside flat walls: refused by both codes.
+    let mut s = oblique.clone();
+    s.analysis = Analysis::None;
+    s.stages = vec![StageSpec { duration: s.duration, ..StageSpec::default() }];
+    out.push(Base { name: "oblique-staged", scene: staged(&s), only: &["stages"], variant_of: None });
     out
 }
 
@@ -637,8 +671,13 @@ fn one_value_fields_admit_no_other_value() {
     s["walls"]["bottom"]["control"] = json!({"pressure": 1e5});
     let e = Scene::from_json(&s.to_string()).expect_err("a loaded bottom wall is refused");
     assert!(e.to_string().contains("walls.bottom.control"), "{e}");
+    // Nor at a protocol's stage.
+    let mut s = json_of(&grainlab::scene::builtin::protocol());
+    s["stages"][1]["walls"]["bottom"]["control"] = json!({"pressure": 1e5});
+    let e = Scene::from_json(&s.to_string()).expect_err("a loaded bottom wall is refused");
+    assert!(e.to_string().contains("stages[1].walls.bottom.control"), "{e}");
     for f in FIELDS.iter().filter(|f| f.liggghts.one_value.is_some() || f.yade.one_value.is_some()) {
-        assert!(f.path.starts_with("walls.bottom.control"), "{}: a one-value field this test does not try", f.path);
+        assert!(f.path.starts_with("walls.bottom.control") || f.path.starts_with("stages[].walls.bottom.control"), "{}: a one-value field this test does not try", f.path);
     }
 }
 

@@ -91,7 +91,30 @@ pub fn cases() -> Vec<Case> {
     s.description = "the shear cell (built-in `shear`) with YADE's incremental tangential force, kinematics and clamp".into();
     s.output.frames = 0;
     out.push(Case { info: CaseInfo { name: "shear/yade".into(), description: s.description.clone(), codes: vec![Code::Yade], quick: false, curve: false }, scene: s });
+    let s = protocol_case();
+    out.push(Case { info: CaseInfo { name: "protocol/liggghts".into(), description: s.description.clone(), codes: vec![Code::Liggghts], quick: true, curve: false }, scene: s });
     out
+}
+
+/// A two-stage protocol in a 200-grain shear cell, with LIGGGHTS' lever arm, under
+/// 100 kPa: sheared at +-0.5 m/s from the start (2 ms, not averaged), then at +-1 m/s
+/// (10 ms, 400 rows, averaged). LIGGGHTS runs the same two stages from the exported deck;
+/// the second stage's time averages are compared as the shear cells'.
+pub fn protocol_case() -> Scene {
+    use crate::scene::{StageSpec, StageWalls, WallChange};
+    let mut s = builtin::shear_cell(200, 0.008);
+    s.model.lever_arm = LeverArm::RadiusMinusHalfOverlap;
+    s.name = "protocol-liggghts".into();
+    s.description = "a two-stage protocol (shear at +-0.5 m/s, then at +-1 m/s, under 100 kPa) in a 200-grain shear cell, with LIGGGHTS' lever arm".into();
+    s.output.frames = 0;
+    s.time_step.rule = crate::scene::TimeStepRule::StepsPerContact { steps: 50.0, impact_speed: 1.0 };
+    let vx = |v: f64| WallChange { velocity_x: Some(v), ..WallChange::default() };
+    s.stages = vec![
+        StageSpec { name: "slow".into(), duration: 0.002, samples: Some(100), average: false, ..StageSpec::default() },
+        StageSpec { name: "fast".into(), duration: 0.01, walls: StageWalls { bottom: vx(-1.0), top: vx(1.0) }, samples: Some(400), average: true, ..StageSpec::default() },
+    ];
+    s.duration = s.stages.iter().map(|st| st.duration).sum();
+    s
 }
 
 /// Settings matched to the code that uses each tangential formulation: LIGGGHTS' lever

@@ -17,7 +17,8 @@ use crate::workbench::export::{Code, ExportInfo};
 /// Read a whitespace table with a header line (series.txt, walls.txt).
 fn read_table(path: &Path) -> Result<(Vec<String>, Vec<Vec<f64>>), Error> {
     let text = std::fs::read_to_string(path).map_err(|e| Error::io(path.display(), e))?;
-    let mut lines = text.lines().filter(|l| !l.trim().is_empty());
+    // A protocol's deck marks each stage's rows with a `#` line.
+    let mut lines = text.lines().filter(|l| !l.trim().is_empty() && !l.starts_with('#'));
     let header: Vec<String> = lines.next().ok_or_else(|| Error::Other(format!("{}: empty", path.display())))?.split_whitespace().map(String::from).collect();
     let mut rows = Vec::new();
     for (k, l) in lines.enumerate() {
@@ -61,7 +62,15 @@ pub fn digest(case_dir: &Path, code: Code, run_dir: &Path) -> Result<PathBuf, Er
             for r in &series {
                 w.row(r)?;
             }
-            std::fs::write(out.join("shear.json"), serde_json::to_string_pretty(&stress_estimates(&series, None)).expect("serialisable") + "\n")
+            // A protocol's averages are its last averaged stage's, as grainlab's summary.
+            let averaged: Vec<WallRow> = match info.stages.iter().rev().find(|st| st.average) {
+                Some(st) => rows.iter().zip(&series).filter(|(r, _)| r[0] > st.first_step as f64 && r[0] <= (st.first_step + st.steps) as f64).map(|(_, w)| *w).collect(),
+                None => series.clone(),
+            };
+            if averaged.len() < 4 {
+                return Err(Error::Other(format!("{}: fewer than 4 rows in the averaged stage", run_dir.join("walls.txt").display())));
+            }
+            std::fs::write(out.join("shear.json"), serde_json::to_string_pretty(&stress_estimates(&averaged, None)).expect("serialisable") + "\n")
                 .map_err(|e| Error::io(out.display(), e))?;
         }
         Analysis::None => return Err(Error::Other("export.json: analysis none".into())),

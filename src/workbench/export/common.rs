@@ -54,6 +54,20 @@ pub struct ExportInfo {
     pub flat_wall: Option<[f64; 3]>,
     /// Columns of the raw output file.
     pub columns: Vec<String>,
+    /// A protocol's stages (none without): each its name, first step (the steps before
+    /// it), steps, and whether the summary averages it. The deck's rows carry the run's
+    /// step, so each row falls in one stage.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub stages: Vec<ExportStage>,
+}
+
+/// One stage of an exported protocol ([`ExportInfo::stages`]).
+#[derive(Clone, Debug, Serialize, serde::Deserialize)]
+pub struct ExportStage {
+    pub name: String,
+    pub first_step: u64,
+    pub steps: u64,
+    pub average: bool,
 }
 
 /// Columns of series.txt for an impact scene with `two` grains (else one grain on a wall).

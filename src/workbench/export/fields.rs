@@ -104,6 +104,9 @@ const Y_L: &str = "flat: `fix wall/gran ... primitive yplane Y`; rough: the row'
 const Y_Y: &str = "flat: `wall(Y, axis=1)`; rough: the row's spheres in grains.data";
 const VX_L: &str = "flat: `shear x V` on the wall/gran fix; rough: the row's velocities in grains.data, kept by `setforce 0.0 ...` and nve";
 const VX_Y: &str = "flat: the wall body's state.vel; rough: the row's velocities in grains.data, kept by blockedDOFs (the loaded row as a clump)";
+const VY_L: &str = "rough: the row's velocities in grains.data, kept by `setforce 0.0 0.0 0.0` and nve";
+const VY_Y: &str = "rough: the row's velocities in grains.data, kept by blockedDOFs 'xyzXYZ'";
+const VY_FLAT: &str = "a flat wall moving in y: the decks' planes do not move in y (refused as walls.NAME.velocity_y)";
 const SURFACE_L: &str = "flat: a primitive `wall/gran` plane (R* = r, m* = m, as grainlab); rough: a row of atoms in grains.data moved as one (setforce + nve)";
 const SURFACE_Y: &str = "flat: a `wall` body with Ig2_Wall_Sphere_ScGeom(hertzian=True); rough: the row's spheres from grains.data, blocked at their velocity (`xyzXYZ`), the loaded top row one clump";
 const FLAT_IN_SHEAR: &str = "a flat wall in a shear scene: the shear decks measure the forces on the rows of rough walls";
@@ -191,6 +194,7 @@ pub const FIELDS: &[Field] = &[
     both("grains.pack.packing_fraction", written(PACKED)),
     each("walls.bottom.y", written(Y_L), written(Y_Y)),
     each("walls.bottom.velocity_x", written(VX_L), written(VX_Y)),
+    each("walls.bottom.velocity_y", written(VY_L).or_refused(VY_FLAT), written(VY_Y).or_refused(VY_FLAT)),
     each(
         "walls.bottom.surface",
         written(SURFACE_L).or_refused(FLAT_IN_SHEAR),
@@ -203,6 +207,7 @@ pub const FIELDS: &[Field] = &[
     each("walls.bottom.material", written(MATERIAL_L), written(MATERIAL_Y)),
     each("walls.top.y", written(Y_L), written(Y_Y)),
     each("walls.top.velocity_x", written(VX_L), written(VX_Y)),
+    each("walls.top.velocity_y", written(VY_L).or_refused(VY_FLAT), written(VY_Y).or_refused(VY_FLAT)),
     each(
         "walls.top.surface",
         written(SURFACE_L).or_refused(FLAT_IN_SHEAR),
@@ -296,7 +301,57 @@ pub const FIELDS: &[Field] = &[
         "analysis",
         written("what the deck records: impact, series.txt at every step; shear, walls.txt; none, nothing (a deck to time or to watch); export.json analysis and columns (an impact without two grains, or a grain and a flat wall, is refused by the scene's own checks)"),
     ),
+    each("stages[].name", written("a `# stage K: NAME` comment and the title line of the stage's rows in walls.txt; export.json stages"), written("the STAGES list; export.json stages")),
+    each(
+        "stages[].duration",
+        written("the stage's `run N` (N = ceil(duration / dt)) after `reset_timestep 0`, the printed step offset by the steps before; export.json stages").or_refused(STAGES_FLAT),
+        written("the stage's steps and first step in STAGES; export.json stages").or_refused(STAGES_OPEN),
+    ),
+    each(
+        "stages[].walls.bottom.velocity_x",
+        written("`velocity bottom set VX ...` on the row before the stage's run (the held row keeps it)"),
+        written("the bottom row's state.vel in STAGES, set before the stage's run"),
+    ),
+    each(
+        "stages[].walls.bottom.velocity_y",
+        written("`velocity bottom set ... VY ...` on the row before the stage's run"),
+        written("the bottom row's state.vel in STAGES, set before the stage's run"),
+    ),
+    both("stages[].walls.bottom.control", one_value(BOTTOM_CONTROL)),
+    both("stages[].walls.bottom.control.pressure", one_value(BOTTOM_CONTROL)),
+    each(
+        "stages[].walls.top.velocity_x",
+        written("`velocity top set VX ...` on the row before the stage's run"),
+        written("the top clump's state.vel in STAGES, set before the stage's run"),
+    ),
+    each(
+        "stages[].walls.top.velocity_y",
+        written("`velocity top set ... VY ...` on the held row before the stage's run"),
+        written("the top clump's state.vel in STAGES (held: blockedDOFs 'xyzXYZ')"),
+    ),
+    each(
+        "stages[].walls.top.control",
+        written("\"fixed\": the row's `aveforce` removed and `setforce 0.0 0.0 0.0`, its y velocity set; a pressure: `setforce 0.0 NULL 0.0` and `aveforce`"),
+        written("\"fixed\": the clump blocked in y (`xyzXYZ`) at its velocity, no load; a pressure: free in y (`xzXYZ`) under setPermF"),
+    ),
+    each(
+        "stages[].walls.top.control.pressure",
+        written("the load p L_x t on the row: `aveforce NULL -F/n NULL` (per atom), replaced at the stage's start (a given walls.top.mass other than the row's atoms' is refused there)"),
+        written("LOAD = p L_x t in STAGES: setPermF on the top clump, free in y"),
+    ),
+    each("stages[].gravity", refused(STAGE_GRAVITY), refused(STAGE_GRAVITY)),
+    each(
+        "stages[].samples",
+        written("the stage's `fix ave/time 1 K K` and `fix print K` (K = steps / samples), re-created at its start"),
+        written("the stage's SAMPLE in STAGES (the row sums restart with the stage)"),
+    ),
+    both("stages[].frames", outside(NOT_PHYSICS_OUTPUT)),
+    both("stages[].average", written("export.json stages[].average: the digest averages the last averaged stage's rows, as grainlab's summary")),
 ];
+
+const STAGES_FLAT: &str = "a protocol with a flat wall: a flat wall's motion and contact histories live in the deck's wall fix or body, not checked across a stage change (refused as stages[0].duration)";
+const STAGES_OPEN: &str = "a protocol without domain.periodic_x, or with a flat wall: the script runs a protocol in the periodic shear cell between rough rows only (refused as stages[0].duration)";
+const STAGE_GRAVITY: &str = "a non-zero gravity, as the scene's own `gravity`: not exported yet";
 
 /// The normalised path of a concrete one: list indices `[k]` become `[]`.
 pub fn normalise(path: &str) -> String {

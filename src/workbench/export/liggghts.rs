@@ -77,7 +77,7 @@ pub(crate) fn deck(scene: &Scene, ex: &Exported) -> Result<String, Error> {
     let _ = writeln!(w, "timestep {}", f(info.time_step_s));
     let _ = writeln!(w, "group free id <> 1 {}", p.n_free);
     let _ = writeln!(w, "run 0");
-    let mut wall_vars = Vec::new();
+    let mut wall_vars: Vec<WallVars> = Vec::new();
     for wall in e.walls() {
         let name = wall.name;
         match &wall.surface {
@@ -113,7 +113,13 @@ pub(crate) fn deck(scene: &Scene, ex: &Exported) -> Result<String, Error> {
     let rotation = model.rotation && !frictionless;
     let _ = writeln!(w, "fix integrate free {}", if rotation { "nve/sphere" } else { "nve" });
     let _ = writeln!(w, "variable s equal step");
-    match if ex.bench { Analysis::None } else { info.analysis } {
+    let record = if ex.bench { Analysis::None } else { info.analysis };
+    if !scene.stages.is_empty() {
+        // A protocol: one block per stage, the wall fixes changed between them.
+        stages(w, scene, ex, record, &mut wall_vars)?;
+        return Ok(s);
+    }
+    match record {
         Analysis::Impact => {
             let mut cols = vec!["${s}".to_string()];
             for k in 1..=p.n_free {
@@ -124,18 +130,7 @@ pub(crate) fn deck(scene: &Scene, ex: &Exported) -> Result<String, Error> {
             }
             let _ = writeln!(w, "fix rec all print 1 \"{}\" file series.txt screen no title \"{}\"", cols.join(" "), info.columns.join(" "));
         }
-        Analysis::Shear => {
-            let k = info.sample_every;
-            let (bot, top) = (&wall_vars[0], &wall_vars[1]);
-            let _ = writeln!(w, "variable gap equal y[{}]-y[{}]", top.3, bot.3);
-            let _ = writeln!(w, "fix avg all ave/time 1 {k} {k} {} {} {} {} v_gap", bot.1, bot.2, top.1, top.2);
-            let mut cols = vec!["${s}".to_string()];
-            for j in 1..=5 {
-                let _ = writeln!(w, "variable a{j} equal f_avg[{j}]");
-                cols.push(format!("${{a{j}}}"));
-            }
-            let _ = writeln!(w, "fix rec all print {k} \"{}\" file walls.txt screen no title \"{}\"", cols.join(" "), info.columns.join(" "));
-        }
+        Analysis::Shear => record_walls(w, info.sample_every, &wall_vars, &format!("file walls.txt screen no title \"{}\"", info.columns.join(" "))),
         Analysis::None => {
             let _ = writeln!(w, "{}", if ex.bench { "# timing deck: nothing recorded" } else { "# analysis none: nothing recorded" });
         }
@@ -143,6 +138,100 @@ pub(crate) fn deck(scene: &Scene, ex: &Exported) -> Result<String, Error> {
     let _ = writeln!(w, "thermo_style custom step atoms\nthermo {}", (info.steps / 10).max(1));
     let _ = writeln!(w, "run {}", info.steps);
     Ok(s)
+}
+
+/// The wall series' recording: the wall forces and the gap averaged over every `k`
+/// steps (`wall_vars`: each wall's name, x and y force, first atom), printed to walls.txt
+/// with `file_args`.
+fn record_walls(w: &mut String, k: u64, wall_vars: &[WallVars], file_args: &str) {
+    let (bot, top) = (&wall_vars[0], &wall_vars[1]);
+    let _ = writeln!(w, "variable gap equal y[{}]-y[{}]", top.3, bot.3);
+    let _ = writeln!(w, "fix avg all ave/time 1 {k} {k} {} {} {} {} v_gap", bot.1, bot.2, top.1, top.2);
+    let mut cols = vec!["${s}".to_string()];
+    for j in 1..=5 {
+        let _ = writeln!(w, "variable a{j} equal f_avg[{j}]");
+        cols.push(format!("${{a{j}}}"));
+    }
+    let _ = writeln!(w, "fix rec all print {k} \"{}\" {file_args}", cols.join(" "));
+}
+
+/// A wall's recorded quantities: its name, the fix outputs of its x and y force, and its
+/// first atom's id.
+type WallVars = (&'static str, String, String, usize);
+
+/// A protocol's stages, each a `run` block. At each stage's start the step counter is
+/// reset (`reset_timestep 0`), so that the averages of the wall series, re-created with
+/// the stage's sampling, start with the stage, as grainlab's rows do; the printed step is
+/// the run's (`step` plus the steps before). A rough row's velocity is set with
+/// `velocity ... set` (a held row keeps it under `setforce 0 0 0` and nve), a change of
+/// its control replaces its `setforce`/`aveforce` fixes. What a flat wall would need
+/// (its motion and history live in its wall/gran fix) and gravity are refused by name.
+fn stages(w: &mut String, scene: &Scene, ex: &Exported, record: Analysis, wall_vars: &mut [WallVars]) -> Result<(), Error> {
+    let e = ex.built.engine.as_ref();
+    let p = e.particles();
+    let info = &ex.info;
+    let phases = crate::study::protocol::phases(scene, info.time_step_s, info.length_m, info.depth_m)?;
+    let mut control: Vec<Control> = e.walls().iter().map(|wall| wall.control).collect();
+    for (k, (ph, st)) in phases.iter().zip(&scene.stages).enumerate() {
+        let _ = writeln!(w, "# stage {}: {} ({} steps from step {})", k + 1, comment(&ph.name), ph.steps, ph.first);
+        if let Some(g) = st.gravity.filter(|g| *g != [0.0, 0.0]) {
+            return Err(refuse(Code::Liggghts, &format!("stages[{k}].gravity"), format!("[{}, {}]", g[0], g[1]), ""));
+        }
+        for (i, wall) in e.walls().iter().enumerate() {
+            let change = &ph.change.walls[i];
+            let name = wall.name;
+            let spec = if i == 0 { &st.walls.bottom } else { &st.walls.top };
+            if spec.is_none() {
+                continue;
+            }
+            let Surface::Rough { grains } = &wall.surface else {
+                return Err(refuse(Code::Liggghts, &format!("stages[{k}].walls.{name}"), "a change", &format!("walls.{name}.surface = flat")));
+            };
+            let atoms = grains.len();
+            let before = control[i];
+            let now = change.control.unwrap_or(before);
+            let mut vy = None;
+            match (before, change.control) {
+                (_, None) => vy = change.velocity_y,
+                (Control::Fixed, Some(Control::Load { force })) | (Control::Load { .. }, Some(Control::Load { force })) => {
+                    let mass: f64 = grains.clone().map(|g| p.m[g]).sum();
+                    if (wall.mass - mass).abs() > 1e-12 * mass {
+                        return Err(refuse(Code::Liggghts, &format!("walls.{name}.mass"), wall.mass, &format!("the row's {atoms} atoms weigh {mass:e} kg")));
+                    }
+                    if before == Control::Fixed {
+                        let _ = writeln!(w, "unfix f_{name}\nfix f_{name} {name} setforce 0.0 NULL 0.0");
+                    } else {
+                        let _ = writeln!(w, "unfix l_{name}");
+                    }
+                    let _ = writeln!(w, "fix l_{name} {name} aveforce NULL {} NULL", f(wall.side * force / atoms as f64));
+                    wall_vars[i].2 = format!("f_l_{name}[2]");
+                }
+                (Control::Load { .. }, Some(Control::Fixed)) => {
+                    let _ = writeln!(w, "unfix l_{name}\nunfix f_{name}\nfix f_{name} {name} setforce 0.0 0.0 0.0");
+                    wall_vars[i].2 = format!("f_f_{name}[2]");
+                    vy = Some(change.velocity_y.unwrap_or(0.0));
+                }
+                (Control::Fixed, Some(Control::Fixed)) => vy = Some(change.velocity_y.unwrap_or(0.0)),
+            }
+            control[i] = now;
+            let vx = change.velocity_x;
+            if vx.is_some() || vy.is_some() {
+                let v = |x: Option<f64>| x.map_or("NULL".to_string(), f);
+                let _ = writeln!(w, "velocity {name} set {} {} NULL units box", v(vx), v(vy));
+            }
+        }
+        let _ = writeln!(w, "reset_timestep 0\nvariable s equal step+{}", ph.first);
+        if record == Analysis::Shear {
+            if k > 0 {
+                let _ = writeln!(w, "unfix rec\nunfix avg");
+            }
+            let file = if k == 0 { format!("file walls.txt screen no title \"{}\"", info.columns.join(" ")) } else { format!("append walls.txt screen no title \"# stage {}\"", comment(&ph.name)) };
+            record_walls(w, ph.sample_every, wall_vars, &file);
+        }
+        let _ = writeln!(w, "thermo_style custom step atoms\nthermo {}", (ph.steps / 10).max(1));
+        let _ = writeln!(w, "run {}", ph.steps);
+    }
+    Ok(())
 }
 
 /// The scene name in a deck comment: [`escaped`], and `&` escaped too. LIGGGHTS reads a

@@ -9,7 +9,7 @@ use crate::error::Error;
 use crate::physics::dim::GrainShape;
 use crate::physics::walls::{Control, Surface};
 use crate::scene::{Analysis, ControlSpec, Grains, Scene, TangentialSpec};
-use crate::workbench::export::common::{Code, ExportInfo, escaped, impact_columns, wall_columns};
+use crate::workbench::export::common::{Code, ExportInfo, ExportStage, escaped, impact_columns, wall_columns};
 use crate::workbench::export::fields;
 
 /// The part of a scene both exporters need, with the checks both share.
@@ -40,8 +40,20 @@ pub(crate) fn prepare(scene: &Scene, code: Code, limits: &crate::scene::limits::
         return Err(fields::refuse(code, &format!("grains.list[{k}].omega"), g.omega, "model.rotation = false"));
     }
     let built = crate::study::build_limited(scene, 1, limits)?;
-    let (steps, sample_every) = crate::engine::timestep::schedule(scene.duration, built.time_step.dt_s, scene.output.samples);
+    let phases = crate::study::protocol::phases(scene, built.time_step.dt_s, built.length, built.depth)?;
+    let (steps, sample_every) = (phases.last().map_or(0, |p| p.last()), phases[0].sample_every);
     let e = built.engine.as_ref();
+    if let Some(w) = e.walls().iter().find(|w| w.is_flat() && w.v.y != 0.0) {
+        return Err(fields::refuse(code, &format!("walls.{}.velocity_y", w.name), w.v.y, &format!("walls.{}.surface = flat", w.name)));
+    }
+    if let Some((k, g)) = scene.stages.iter().enumerate().find_map(|(k, st)| st.gravity.filter(|g| *g != [0.0, 0.0]).map(|g| (k, g))) {
+        return Err(fields::refuse(code, &format!("stages[{k}].gravity"), format!("[{}, {}]", g[0], g[1]), ""));
+    }
+    if !scene.stages.is_empty()
+        && let Some(w) = e.walls().iter().find(|w| w.is_flat())
+    {
+        return Err(fields::refuse(code, "stages[0].duration", format!("{} s", scene.stages[0].duration), &format!("walls.{}.surface = flat", w.name)));
+    }
     let n_free = e.particles().n_free;
     let walls = e.walls();
     if let Some(w) = walls.iter().find(|w| w.is_flat() && w.control != Control::Fixed) {
@@ -74,6 +86,7 @@ pub(crate) fn prepare(scene: &Scene, code: Code, limits: &crate::scene::limits::
         length_m: built.length,
         depth_m: built.depth,
         columns,
+        stages: phases.iter().filter(|p| !p.name.is_empty()).map(|p| ExportStage { name: p.name.clone(), first_step: p.first, steps: p.steps, average: p.average }).collect(),
     };
     Ok(Exported { built, info, bench: false })
 }

@@ -122,11 +122,19 @@ pub(crate) fn deck(scene: &Scene, ex: &Exported) -> Result<String, Error> {
         // A given mass of the loaded wall: the clump's, which NewtonIntegrator divides the
         // clump's force by (its spheres keep their own masses for the contact damping).
         let given = scene.walls.as_ref().and_then(|ws| ws.top.mass);
-        if load > 0.0 && given.is_some() {
+        let loaded_later = scene.stages.iter().any(|st| matches!(st.walls.top.control, Some(crate::scene::ControlSpec::Pressure(_))));
+        if (load > 0.0 || loaded_later) && given.is_some() {
             let _ = writeln!(w, "c.mass = {}  # walls.top.mass, kg", f(walls[1].mass));
         }
-        let _ = writeln!(w, "{}", SHEAR_RUN);
+        if scene.stages.is_empty() {
+            let _ = writeln!(w, "{}", SHEAR_RUN);
+        } else {
+            let _ = writeln!(w, "{}", stages(scene, ex)?);
+        }
         return Ok(s);
+    }
+    if !scene.stages.is_empty() {
+        return Err(refuse(Code::Yade, "stages[0].duration", format!("{} s", scene.stages[0].duration), "no domain.periodic_x"));
     }
     if walls.iter().any(|w| !w.is_flat()) {
         // Rough rows (held: a loaded one was refused above) follow the free grains in
@@ -177,6 +185,58 @@ O.engines = [
     NewtonIntegrator(damping=0.0),
 ]
 O.dt = DT"#;
+
+/// A protocol's run: the rows averaged over each stage's own sampling from its start
+/// (`FIRST`; the sums restart with each stage, as grainlab's rows do), and at each
+/// stage's start the rows' velocities, the top clump's control (blocked in y and held,
+/// or free in y under a permanent load) set as the stage says.
+fn stages(scene: &Scene, ex: &Exported) -> Result<String, Error> {
+    let info = &ex.info;
+    let phases = crate::study::protocol::phases(scene, info.time_step_s, info.length_m, info.depth_m)?;
+    let mut rows = Vec::new();
+    for (k, (ph, st)) in phases.iter().zip(&scene.stages).enumerate() {
+        if let Some(g) = st.gravity.filter(|g| *g != [0.0, 0.0]) {
+            return Err(refuse(Code::Yade, &format!("stages[{k}].gravity"), format!("[{}, {}]", g[0], g[1]), ""));
+        }
+        let py = |x: Option<f64>| x.map_or("None".to_string(), f);
+        let [b, t] = &ph.change.walls;
+        let load = match t.control {
+            Some(Control::Load { force }) => f(force),
+            Some(Control::Fixed) => "0.0".into(),
+            None => "None".into(),
+        };
+        rows.push(format!(
+            "    ({:?}, {}, {}, {}, {}, {}, {}, {}, {load}),",
+            ph.name,
+            ph.first,
+            ph.steps,
+            ph.sample_every,
+            py(b.velocity_x),
+            py(b.velocity_y),
+            py(t.velocity_x),
+            py(t.velocity_y.or(t.control.filter(|c| *c == Control::Fixed).map(|_| 0.0)))
+        ));
+    }
+    let run = SHEAR_RUN.replace("    if O.iter % SAMPLE == 0:", "    if (O.iter - FIRST) % SAMPLE == 0:").replace(
+        "O.run(STEPS, True)\n",
+        &format!("# name, first step, steps, sample, bottom vx, vy, top vx, vy (None: unchanged), top load (N; 0 held, None unchanged)\nSTAGES = [\n{}\n]\n{STAGE_LOOP}\n", rows.join("\n")),
+    );
+    Ok(format!("FIRST = 0\n{run}"))
+}
+
+const STAGE_LOOP: &str = r#"for name, first, steps, sample, bvx, bvy, tvx, tvy, load in STAGES:
+    FIRST, SAMPLE = first, sample
+    for k in range(5):
+        acc[k] = 0.0
+    for i in bottom:
+        v = O.bodies[i].state.vel
+        O.bodies[i].state.vel = Vector3(v[0] if bvx is None else bvx, v[1] if bvy is None else bvy, 0)
+    if load is not None:
+        LOAD = load
+        c.blockedDOFs = 'xzXYZ' if LOAD > 0 else 'xyzXYZ'
+        O.forces.setPermF(top_clump, Vector3(0, -LOAD, 0))
+    c.vel = Vector3(c.vel[0] if tvx is None else tvx, c.vel[1] if tvy is None else tvy, 0)
+    O.run(steps, True)"#;
 
 const IMPACT_SETUP: &str = r#"ids = [O.bodies.append(b) for b in grains()]"#;
 
