@@ -78,6 +78,15 @@ fn bases(dir: &Path) -> Vec<Value> {
     let mut shear = builtin::shear_cell(200, 0.008);
     shear.output.frames = 3;
     out.push(json(&shear));
+    // A protocol in that cell: every stage field set, each stage a few dozen steps.
+    let mut staged = json(&shear);
+    staged.as_object_mut().unwrap().remove("duration");
+    staged["stages"] = json!([
+        {"name": "held", "duration": 4e-6, "walls": {"bottom": {"velocity_x": -0.5, "velocity_y": 0.0, "control": "fixed"}, "top": {"velocity_x": 0.5, "velocity_y": -0.01, "control": "fixed"}}, "gravity": [0.0, -9.81], "samples": 3, "frames": 1, "average": false},
+        {"name": "loaded", "duration": 4e-6, "walls": {"top": {"control": {"pressure": 1e5}}}},
+        {"duration": 1e-5, "walls": {"bottom": {"velocity_x": -1.0}, "top": {"velocity_x": 1.0}}, "gravity": [0.0, 0.0]}
+    ]);
+    out.push(staged);
     let mut pair = json(&builtin::oblique_pair(grainlab::physics::material::Material::default(), 1e-3, 1.0, 30.0, grainlab::scene::TangentialSpec::IncrementalForce, 50.0));
     pair["model"]["limit_force"] = true.into();
     pair["gravity"] = json!([0.0, -9.81]);
