@@ -159,7 +159,7 @@ impl Scene {
         if let Some(v) = self.time_step.characteristic_speed {
             check(finite_pos(v), "time_step", "characteristic_speed", v, "> 0 m/s")?;
         }
-        check(finite_pos(self.duration), "", "duration", self.duration, "> 0 s")?;
+        check(finite_pos(self.duration), "", "duration", self.duration, if self.stages.is_empty() { "> 0 s (required without stages)" } else { "> 0 s" })?;
         check(finite_pos(self.neighbor.skin) && self.neighbor.skin <= 2.0, "neighbor", "skin", self.neighbor.skin, "(0, 2] smallest diameters")?;
         check(self.output.samples >= 1, "output", "samples", self.output.samples, ">= 1")?;
         check(self.output.frames <= MAX_FRAMES, "output", "frames", self.output.frames, &format!("0 to {MAX_FRAMES} (each frame rewrites the .pvd index and the manifest)"))?;
