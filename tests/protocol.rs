@@ -187,3 +187,22 @@ fn explain_prints_the_stages() {
     let line = built.explain();
     assert!(line.contains("stages: compress (0.01 s: not averaged) -> relax (0.005 s: not averaged) -> shear 0.5 (0.03 s: bottom vx -0.5 m/s; top vx 0.5 m/s) -> shear 2"), "{line}");
 }
+
+/// A wall changed to fixed control without a y velocity is held, in the exported decks as
+/// in grainlab: the bottom row, started moving up, stops in y at the stage's start.
+#[test]
+fn exported_stages_hold_a_wall_changed_to_fixed() {
+    use grainlab::workbench::export::{Code, export_files};
+    let mut s = shear_cell(60, 0.004);
+    s.output.frames = 0;
+    s.walls.as_mut().unwrap().bottom.velocity_y = 1e-3;
+    s.stages = vec![stage("held", 1e-5, WallChange { control: Some(ControlSpec::Fixed), ..WallChange::default() }, WallChange::default())];
+    s.duration = 1e-5;
+    let deck = |code| export_files(&s, code, false, &Default::default()).unwrap()[0].1.clone();
+    let zero = "0.00000000000000000e0";
+    assert!(deck(Code::Liggghts).contains(&format!("velocity bottom set NULL {zero} NULL units box")), "{}", deck(Code::Liggghts));
+    // YADE's STAGES row: name, first, steps, sample, bottom vx, bottom vy, ...
+    let yade = deck(Code::Yade);
+    let row = yade.lines().find(|l| l.starts_with("    (\"held\"")).expect("the stage's row");
+    assert_eq!(row.split(", ").nth(5), Some(zero), "{row}");
+}

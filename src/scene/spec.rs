@@ -118,6 +118,14 @@ impl WallChange {
     pub fn is_none(&self) -> bool {
         *self == WallChange::default()
     }
+    /// The y velocity the change sets, m/s: its own, or 0 (held) when it changes the wall
+    /// to fixed control without one; `None` leaves the wall's as it is.
+    pub fn velocity_y_set(&self) -> Option<f64> {
+        self.velocity_y.or(match self.control {
+            Some(ControlSpec::Fixed) => Some(0.0),
+            _ => None,
+        })
+    }
 }
 
 fn default_materials() -> Vec<Material> {

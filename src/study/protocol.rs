@@ -25,10 +25,9 @@ pub struct Phase {
     pub frame_every: Option<u64>,
     /// The summary averages the stage's wall stresses.
     pub average: bool,
-    /// What changes at the stage's start (before its first step).
+    /// What changes at the stage's start (before its first step); its y velocities are
+    /// resolved ([`WallChange::velocity_y_set`]).
     pub change: MotionChange,
-    /// The stage's start as the scene says it, s (the sum of the durations before).
-    pub start_s: f64,
 }
 
 impl Phase {
@@ -45,7 +44,7 @@ pub fn phases(scene: &Scene, dt: f64, length: f64, depth: f64) -> Result<Vec<Pha
     if scene.stages.is_empty() {
         let (total, sample_every) = schedule(scene.duration, dt, scene.output.samples);
         let frame_every = (scene.output.frames > 0).then(|| (total / scene.output.frames).max(1));
-        return Ok(vec![Phase { name: String::new(), first: 0, steps: total, sample_every, frame_every, average: true, change: MotionChange::default(), start_s: 0.0 }]);
+        return Ok(vec![Phase { name: String::new(), first: 0, steps: total, sample_every, frame_every, average: true, change: MotionChange::default() }]);
     }
     let total_s: f64 = scene.stages.iter().map(|s| s.duration).sum();
     // A count shared out by duration: cumulative rounding, so the stages' shares add up.
@@ -64,7 +63,7 @@ pub fn phases(scene: &Scene, dt: f64, length: f64, depth: f64) -> Result<Vec<Pha
         let end = start + st.duration;
         let samples = st.samples.unwrap_or_else(|| share(scene.output.samples, start, end).max(1));
         let frames = st.frames.unwrap_or_else(|| share(scene.output.frames, start, end));
-        let motion = |c: &WallChange| WallMotion { velocity_x: c.velocity_x, velocity_y: c.velocity_y, control: c.control.as_ref().map(|c| control(c, length, depth)) };
+        let motion = |c: &WallChange| WallMotion { velocity_x: c.velocity_x, velocity_y: c.velocity_y_set(), control: c.control.as_ref().map(|c| control(c, length, depth)) };
         let change = MotionChange { walls: [motion(&st.walls.bottom), motion(&st.walls.top)], gravity: st.gravity.map(Vec2::from) };
         out.push(Phase {
             name: scene.stage_name(k),
@@ -74,7 +73,6 @@ pub fn phases(scene: &Scene, dt: f64, length: f64, depth: f64) -> Result<Vec<Pha
             frame_every: (frames > 0).then(|| (steps / frames).max(1)),
             average: st.average,
             change,
-            start_s: start,
         });
         first += steps;
         start = end;

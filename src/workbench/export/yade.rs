@@ -194,10 +194,8 @@ fn stages(scene: &Scene, ex: &Exported) -> Result<String, Error> {
     let info = &ex.info;
     let phases = crate::study::protocol::phases(scene, info.time_step_s, info.length_m, info.depth_m)?;
     let mut rows = Vec::new();
-    for (k, (ph, st)) in phases.iter().zip(&scene.stages).enumerate() {
-        if let Some(g) = st.gravity.filter(|g| *g != [0.0, 0.0]) {
-            return Err(refuse(Code::Yade, &format!("stages[{k}].gravity"), format!("[{}, {}]", g[0], g[1]), ""));
-        }
+    // (A stage's gravity was refused in `prepare`.)
+    for ph in &phases {
         let py = |x: Option<f64>| x.map_or("None".to_string(), f);
         let [b, t] = &ph.change.walls;
         let load = match t.control {
@@ -214,7 +212,7 @@ fn stages(scene: &Scene, ex: &Exported) -> Result<String, Error> {
             py(b.velocity_x),
             py(b.velocity_y),
             py(t.velocity_x),
-            py(t.velocity_y.or(t.control.filter(|c| *c == Control::Fixed).map(|_| 0.0)))
+            py(t.velocity_y)
         ));
     }
     let run = SHEAR_RUN.replace("    if O.iter % SAMPLE == 0:", "    if (O.iter - FIRST) % SAMPLE == 0:").replace(
