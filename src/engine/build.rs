@@ -317,11 +317,7 @@ pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<B
     // Every stage of a protocol takes at least a step.
     let counts = crate::engine::timestep::stage_steps(scene.stages.iter().map(|s| s.duration), dt);
     if let Some(k) = counts.iter().position(|&n| n == 0) {
-        return Err(Error::Invalid {
-            field: format!("stages[{k}].duration"),
-            value: format!("{} s", scene.stages[k].duration),
-            allowed: format!("a stage of at least one step (dt = {dt:.3e} s): it begins and ends within the same step"),
-        });
+        return Err(crate::engine::timestep::stage_too_short(k, scene.stages[k].duration, dt));
     }
     // The rows the summary keeps: a wall row per sample, an impact curve point per step
     // in contact (at most every step, and at most MAX_CURVE_POINTS).

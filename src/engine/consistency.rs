@@ -200,38 +200,60 @@ pub fn start_overlaps(p: &Particles, walls: &[Wall], boundary: &Boundary, names:
     Ok(worst)
 }
 
+/// The most anything may move in one step of `dt`: [`MAX_STEP_MOVE`] of the smallest
+/// free grain's radius.
+struct StepBound {
+    most: f64,
+    dt: f64,
+}
+
+impl StepBound {
+    fn of(p: &Particles, dt: f64) -> StepBound {
+        let r_min = p.r[..p.n_free].iter().cloned().fold(f64::INFINITY, f64::min);
+        StepBound { most: MAX_STEP_MOVE * r_min, dt }
+    }
+
+    /// `Err` (field `field`, value `value`) when `what` moves `step` m in a step, more
+    /// than the bound.
+    fn check(&self, field: impl Into<String>, value: String, what: &str, step: f64) -> Result<(), Error> {
+        let (most, dt) = (self.most, self.dt);
+        if step <= most {
+            return Ok(());
+        }
+        Err(refuse(
+            field,
+            value,
+            format!(
+                "{what} of at most {most:.3e} m per step ({MAX_STEP_MOVE} of the smallest radius) at dt = {dt:.3e} s; it moves {step:.3e} m: the contact could not be resolved. Use a smaller time step (more steps per contact) or a lower speed"
+            ),
+        ))
+    }
+
+    /// A wall at velocity `v`, set at `field` (its x velocity's path; the value names the
+    /// y velocity too when the wall has one).
+    fn wall(&self, field: String, v: Vec2) -> Result<(), Error> {
+        let value = if v.y == 0.0 { v.x.shown().to_string() } else { format!("[{}, {}] m/s", v.x.shown(), v.y.shown()) };
+        self.check(field, value, "a wall speed", v.norm() * self.dt)
+    }
+
+    /// Gravity `g`, set at `field`: what it adds to a grain's move in one step.
+    fn gravity(&self, field: String, g: Vec2) -> Result<(), Error> {
+        self.check(field, format!("[{}, {}] m/s^2", g.x.shown(), g.y.shown()), "a gravity that adds", g.norm() * self.dt * self.dt)
+    }
+}
+
 /// No grain, grain surface or wall moving more than [`MAX_STEP_MOVE`] of the smallest
 /// radius in one step of `dt`, nor gravity adding that much to a move in one step.
 pub fn motion(p: &Particles, walls: &[Wall], gravity: Vec2, names: &GrainNames, dt: f64) -> Result<(), Error> {
-    let r_min = p.r[..p.n_free].iter().cloned().fold(f64::INFINITY, f64::min);
-    let most = MAX_STEP_MOVE * r_min;
-    let allowed = |what: &str, now: f64| {
-        format!(
-            "{what} of at most {most:.3e} m per step ({MAX_STEP_MOVE} of the smallest radius) at dt = {dt:.3e} s; it moves {now:.3e} m: the contact could not be resolved. Use a smaller time step (more steps per contact) or a lower speed"
-        )
-    };
+    let bound = StepBound::of(p, dt);
     for i in 0..p.n_free {
-        let step = p.v[i].norm() * dt;
-        if !(step <= most) {
-            return Err(refuse(names.field(i, "v"), format!("[{}, {}] m/s", p.v[i].x.shown(), p.v[i].y.shown()), allowed("a speed", step)));
-        }
-        let surface = p.omega[i].abs() * p.r[i] * dt;
-        if !(surface <= most) {
-            return Err(refuse(names.field(i, "omega"), format!("{} rad/s", p.omega[i].shown()), allowed("a spin whose surface moves", surface)));
-        }
+        bound.check(names.field(i, "v"), format!("[{}, {}] m/s", p.v[i].x.shown(), p.v[i].y.shown()), "a speed", p.v[i].norm() * dt)?;
+        bound.check(names.field(i, "omega"), format!("{} rad/s", p.omega[i].shown()), "a spin whose surface moves", p.omega[i].abs() * p.r[i] * dt)?;
     }
     for w in walls {
-        let step = w.v.norm() * dt;
-        if !(step <= most) {
-            return Err(refuse(format!("walls.{}.velocity_x", w.name), w.v.x.shown(), allowed("a wall speed", step)));
-        }
+        bound.wall(format!("walls.{}.velocity_x", w.name), w.v)?;
     }
-    // What gravity adds to a grain's move in one step.
-    let step = gravity.norm() * dt * dt;
-    if !(step <= most) {
-        return Err(refuse("gravity", format!("[{}, {}] m/s^2", gravity.x.shown(), gravity.y.shown()), allowed("a gravity that adds", step)));
-    }
-    Ok(())
+    bound.gravity("gravity".into(), gravity)
 }
 
 /// The time step must be stable for every pair of materials the scene's grains and walls
@@ -329,36 +351,19 @@ pub fn load(scene: &Scene, p: &Particles, walls: &[Wall], length: f64, depth: f6
 /// Each stage of a protocol as [`motion`] and [`load`] check the scene's start: the walls'
 /// speeds, gravity, and each load a stage puts on the top wall.
 pub fn stages(scene: &Scene, p: &Particles, walls: &[Wall], length: f64, depth: f64, dt: f64) -> Result<(), Error> {
-    let r_min = p.r[..p.n_free].iter().cloned().fold(f64::INFINITY, f64::min);
-    let most = MAX_STEP_MOVE * r_min;
-    let allowed = |what: &str, now: f64| format!("{what} of at most {most:.3e} m per step ({MAX_STEP_MOVE} of the smallest radius) at dt = {dt:.3e} s; it moves {now:.3e} m: use a smaller time step or a lower speed");
-    let mut v: Vec<Vec2> = walls.iter().map(|w| w.v).collect();
-    let n_walls = v.len();
+    let bound = StepBound::of(p, dt);
+    let velocities = scene.wall_velocities();
     for (k, st) in scene.stages.iter().enumerate() {
-        for (w, (name, c)) in [("bottom", &st.walls.bottom), ("top", &st.walls.top)].into_iter().enumerate().filter(|(w, _)| *w < n_walls) {
-            let at = format!("stages[{k}].walls.{name}");
-            if let Some(x) = c.velocity_x {
-                v[w].x = x;
-            }
-            if c.control.is_some() {
-                v[w].y = 0.0;
-            }
-            if let Some(y) = c.velocity_y {
-                v[w].y = y;
-            }
-            let step = v[w].norm() * dt;
-            if !(step <= most) {
-                return Err(refuse(format!("{at}.velocity_x"), format!("[{}, {}] m/s", v[w].x.shown(), v[w].y.shown()), allowed("a wall speed", step)));
-            }
-            if let Some(ControlSpec::Pressure(pa)) = c.control {
-                load_on(scene, p, walls, &walls[w], pa, &at, length, depth, dt)?;
+        for (w, wall) in walls.iter().enumerate() {
+            let at = format!("stages[{k}].walls.{}", wall.name);
+            bound.wall(format!("{at}.velocity_x"), Vec2::from(velocities[k + 1][w]))?;
+            let change = if w == 0 { &st.walls.bottom } else { &st.walls.top };
+            if let Some(ControlSpec::Pressure(pa)) = change.control {
+                load_on(scene, p, walls, wall, pa, &at, length, depth, dt)?;
             }
         }
         if let Some(g) = st.gravity {
-            let step = Vec2::from(g).norm() * dt * dt;
-            if !(step <= most) {
-                return Err(refuse(format!("stages[{k}].gravity"), format!("[{}, {}] m/s^2", g[0].shown(), g[1].shown()), allowed("a gravity that adds", step)));
-            }
+            bound.gravity(format!("stages[{k}].gravity"), Vec2::from(g))?;
         }
     }
     Ok(())

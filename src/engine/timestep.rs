@@ -171,6 +171,15 @@ pub fn stage_steps(durations: impl Iterator<Item = f64>, dt: f64) -> Vec<u64> {
         .collect()
 }
 
+/// The refusal of stage `k` of `duration` s that takes no step at `dt`.
+pub fn stage_too_short(k: usize, duration: f64, dt: f64) -> Error {
+    Error::Invalid {
+        field: format!("stages[{k}].duration"),
+        value: format!("{duration} s"),
+        allowed: format!("a stage of at least one step (dt = {dt:.3e} s): it begins and ends within the same step"),
+    }
+}
+
 /// The steps a run of `duration` s takes at `dt` (at least one), as a float: NaN or
 /// infinite for a dt that is not finite and > 0 ([`step_count`] refuses those).
 fn steps_of(duration: f64, dt: f64) -> f64 {

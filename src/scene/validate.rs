@@ -299,26 +299,26 @@ impl Scene {
         s
     }
 
-    /// The fastest wall speed of the scene and of any of its stages, m/s.
-    pub fn fastest_wall(&self) -> f64 {
-        let Some(w) = &self.walls else { return 0.0 };
-        let mut v = [(w.bottom.velocity_x, w.bottom.velocity_y), (w.top.velocity_x, w.top.velocity_y)];
-        let mut most = v.iter().map(|(x, y)| x.hypot(*y)).fold(0.0, f64::max);
+    /// The walls' velocities `[bottom, top]`, m/s: the scene's, then after each stage's
+    /// changes (element k + 1 is stage k's). Empty without walls. A loaded wall's y
+    /// velocity is its own dynamics: here it keeps the value it was given.
+    pub fn wall_velocities(&self) -> Vec<[[f64; 2]; 2]> {
+        let Some(w) = &self.walls else { return Vec::new() };
+        let mut v = [[w.bottom.velocity_x, w.bottom.velocity_y], [w.top.velocity_x, w.top.velocity_y]];
+        let mut out = vec![v];
         for st in &self.stages {
             for (k, c) in [&st.walls.bottom, &st.walls.top].into_iter().enumerate() {
-                if let Some(x) = c.velocity_x {
-                    v[k].0 = x;
-                }
-                if c.control.is_some() {
-                    v[k].1 = 0.0;
-                }
-                if let Some(y) = c.velocity_y {
-                    v[k].1 = y;
-                }
+                v[k][0] = c.velocity_x.unwrap_or(v[k][0]);
+                v[k][1] = c.velocity_y_set().unwrap_or(v[k][1]);
             }
-            most = v.iter().map(|(x, y)| x.hypot(*y)).fold(most, f64::max);
+            out.push(v);
         }
-        most
+        out
+    }
+
+    /// The fastest wall speed of the scene and of any of its stages, m/s.
+    pub fn fastest_wall(&self) -> f64 {
+        self.wall_velocities().iter().flatten().map(|v| v[0].hypot(v[1])).fold(0.0, f64::max)
     }
 
     /// The strongest gravity of the scene and of any of its stages, m/s^2.

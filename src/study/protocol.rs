@@ -4,7 +4,7 @@
 //! no `stage` column), on the schedule every run had before protocols.
 
 use crate::engine::build::control;
-use crate::engine::timestep::{schedule, stage_steps, step_count};
+use crate::engine::timestep::{schedule, stage_steps, stage_too_short, step_count};
 use crate::engine::world::{MotionChange, WallMotion};
 use crate::error::Error;
 use crate::physics::dim::Vec2;
@@ -58,7 +58,7 @@ pub fn phases(scene: &Scene, dt: f64, length: f64, depth: f64) -> Result<Vec<Pha
     for (k, st) in scene.stages.iter().enumerate().take(kept) {
         let steps = counts[k];
         if steps == 0 {
-            return Err(Error::Invalid { field: format!("stages[{k}].duration"), value: format!("{} s", st.duration), allowed: format!("a stage of at least one step (dt = {dt:.3e} s): it begins and ends within the same step") });
+            return Err(stage_too_short(k, st.duration, dt));
         }
         let end = start + st.duration;
         let samples = st.samples.unwrap_or_else(|| share(scene.output.samples, start, end).max(1));

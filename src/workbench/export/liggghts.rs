@@ -20,6 +20,7 @@ use super::prepare::Exported;
 use crate::error::Error;
 use crate::physics::contact::LeverArm;
 use crate::physics::material::PairMaterial;
+use crate::engine::world::WallMotion;
 use crate::physics::walls::{Control, Surface};
 use crate::scene::{Analysis, Scene, TangentialSpec};
 
@@ -94,15 +95,8 @@ pub(crate) fn deck(scene: &Scene, ex: &Exported) -> Result<String, Error> {
                         wall_vars.push((name, format!("f_f_{name}[1]"), format!("f_f_{name}[2]"), a));
                     }
                     Control::Load { force } => {
-                        // The row moves as its atoms: its mass is theirs (equal atoms, so
-                        // aveforce's equal forces keep it rigid).
-                        let atoms: f64 = grains.clone().map(|k| p.m[k]).sum();
-                        if (wall.mass - atoms).abs() > 1e-12 * atoms {
-                            return Err(refuse(Code::Liggghts, &format!("walls.{name}.mass"), wall.mass, &format!("the row's {} atoms weigh {atoms:e} kg", grains.len())));
-                        }
                         let _ = writeln!(w, "fix f_{name} {name} setforce 0.0 NULL 0.0");
-                        let _ = writeln!(w, "# the load {} N on the row, per atom (aveforce adds its value to each atom)", f(force));
-                        let _ = writeln!(w, "fix l_{name} {name} aveforce NULL {} NULL", f(wall.load_y() / (b + 1 - a) as f64));
+                        load_row(w, wall, grains, p, force)?;
                         wall_vars.push((name, format!("f_f_{name}[1]"), format!("f_l_{name}[2]"), a));
                     }
                 }
@@ -172,49 +166,35 @@ fn stages(w: &mut String, scene: &Scene, ex: &Exported, record: Analysis, wall_v
     let info = &ex.info;
     let phases = crate::study::protocol::phases(scene, info.time_step_s, info.length_m, info.depth_m)?;
     let mut control: Vec<Control> = e.walls().iter().map(|wall| wall.control).collect();
-    for (k, (ph, st)) in phases.iter().zip(&scene.stages).enumerate() {
+    // (A stage's gravity and a protocol beside a flat wall were refused in `prepare`.)
+    for (k, ph) in phases.iter().enumerate() {
         let _ = writeln!(w, "# stage {}: {} ({} steps from step {})", k + 1, comment(&ph.name), ph.steps, ph.first);
-        if let Some(g) = st.gravity.filter(|g| *g != [0.0, 0.0]) {
-            return Err(refuse(Code::Liggghts, &format!("stages[{k}].gravity"), format!("[{}, {}]", g[0], g[1]), ""));
-        }
         for (i, wall) in e.walls().iter().enumerate() {
             let change = &ph.change.walls[i];
-            let name = wall.name;
-            let spec = if i == 0 { &st.walls.bottom } else { &st.walls.top };
-            if spec.is_none() {
+            if *change == WallMotion::default() {
                 continue;
             }
-            let Surface::Rough { grains } = &wall.surface else {
-                return Err(refuse(Code::Liggghts, &format!("stages[{k}].walls.{name}"), "a change", &format!("walls.{name}.surface = flat")));
-            };
-            let atoms = grains.len();
-            let before = control[i];
-            let now = change.control.unwrap_or(before);
-            let mut vy = None;
-            match (before, change.control) {
-                (_, None) => vy = change.velocity_y,
-                (Control::Fixed, Some(Control::Load { force })) | (Control::Load { .. }, Some(Control::Load { force })) => {
-                    let mass: f64 = grains.clone().map(|g| p.m[g]).sum();
-                    if (wall.mass - mass).abs() > 1e-12 * mass {
-                        return Err(refuse(Code::Liggghts, &format!("walls.{name}.mass"), wall.mass, &format!("the row's {atoms} atoms weigh {mass:e} kg")));
-                    }
+            let name = wall.name;
+            let Surface::Rough { grains } = &wall.surface else { unreachable!("prepare refuses a protocol beside a flat wall") };
+            match (control[i], change.control) {
+                (_, None) | (Control::Fixed, Some(Control::Fixed)) => {}
+                (before, Some(Control::Load { force })) => {
                     if before == Control::Fixed {
                         let _ = writeln!(w, "unfix f_{name}\nfix f_{name} {name} setforce 0.0 NULL 0.0");
                     } else {
                         let _ = writeln!(w, "unfix l_{name}");
                     }
-                    let _ = writeln!(w, "fix l_{name} {name} aveforce NULL {} NULL", f(wall.side * force / atoms as f64));
+                    load_row(w, wall, grains, p, force)?;
                     wall_vars[i].2 = format!("f_l_{name}[2]");
                 }
                 (Control::Load { .. }, Some(Control::Fixed)) => {
                     let _ = writeln!(w, "unfix l_{name}\nunfix f_{name}\nfix f_{name} {name} setforce 0.0 0.0 0.0");
                     wall_vars[i].2 = format!("f_f_{name}[2]");
-                    vy = Some(change.velocity_y.unwrap_or(0.0));
                 }
-                (Control::Fixed, Some(Control::Fixed)) => vy = Some(change.velocity_y.unwrap_or(0.0)),
             }
-            control[i] = now;
-            let vx = change.velocity_x;
+            control[i] = change.control.unwrap_or(control[i]);
+            // The y velocity as resolved for the stage (0 for a wall changed to fixed).
+            let (vx, vy) = (change.velocity_x, change.velocity_y);
             if vx.is_some() || vy.is_some() {
                 let v = |x: Option<f64>| x.map_or("NULL".to_string(), f);
                 let _ = writeln!(w, "velocity {name} set {} {} NULL units box", v(vx), v(vy));
@@ -231,6 +211,20 @@ fn stages(w: &mut String, scene: &Scene, ex: &Exported, record: Analysis, wall_v
         let _ = writeln!(w, "thermo_style custom step atoms\nthermo {}", (ph.steps / 10).max(1));
         let _ = writeln!(w, "run {}", ph.steps);
     }
+    Ok(())
+}
+
+/// The load `force` (N) on a rough `wall`'s row of `grains`: `aveforce` adds its share to
+/// each atom. The row moves as its atoms, so its mass must be theirs (equal atoms, so
+/// aveforce's equal forces keep it rigid): another is refused by name.
+fn load_row(w: &mut String, wall: &crate::physics::walls::Wall, grains: &std::ops::Range<usize>, p: &crate::physics::particles::Particles, force: f64) -> Result<(), Error> {
+    let name = wall.name;
+    let atoms: f64 = grains.clone().map(|k| p.m[k]).sum();
+    if (wall.mass - atoms).abs() > 1e-12 * atoms {
+        return Err(refuse(Code::Liggghts, &format!("walls.{name}.mass"), wall.mass, &format!("the row's {} atoms weigh {atoms:e} kg", grains.len())));
+    }
+    let _ = writeln!(w, "# the load {} N on the row, per atom (aveforce adds its value to each atom)", f(force));
+    let _ = writeln!(w, "fix l_{name} {name} aveforce NULL {} NULL", f(wall.side * force / grains.len() as f64));
     Ok(())
 }
 
