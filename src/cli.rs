@@ -374,7 +374,7 @@ fn compare(root: &std::path::Path, filter: Option<&str>, csv: Option<&std::path:
     }
     say!("{:<40} {:<9} {:<32} {:>14} {:>14} {:>10} {:>9} pass", "case", "code", "quantity", "engine", "reference", "diff", "bound")?;
     for r in &rows {
-        let (d, kind) = if r.relative { (r.rel_diff, "rel") } else { (r.abs_diff, "abs") };
+        let (d, kind) = (r.diff(), if r.relative { "rel" } else { "abs" });
         say!(
             "{:<40} {:<9} {:<32} {:>14.7e} {:>14.7e} {:>10.2e} {:>5.0e} {kind} {}",
             r.case,

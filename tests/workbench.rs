@@ -27,7 +27,7 @@ fn check_all(prefix: &str, code: Code) -> Vec<Row> {
     for d in cases_with(prefix, code) {
         rows.extend(compare_case(&d).unwrap().into_iter().filter(|r| r.code == code));
     }
-    let bad: Vec<String> = rows.iter().filter(|r| !r.pass).map(|r| format!("{} {}: engine {} vs {} (diff {:e}, bound {:e})", r.case, r.quantity, r.engine, r.reference, if r.relative { r.rel_diff } else { r.abs_diff }, r.tolerance)).collect();
+    let bad: Vec<String> = rows.iter().filter(|r| !r.pass).map(|r| format!("{} {}: engine {} vs {} (diff {:e}, bound {:e})", r.case, r.quantity, r.engine, r.reference, r.diff(), r.tolerance)).collect();
     assert!(bad.is_empty(), "{} of {} comparisons outside their bound:\n{}", bad.len(), rows.len(), bad.join("\n"));
     rows
 }

@@ -24,8 +24,9 @@ pub struct Row {
     pub reference: f64,
     /// |engine - reference|.
     pub abs_diff: f64,
-    /// |engine - reference| / |reference|.
-    pub rel_diff: f64,
+    /// |engine - reference| / |reference|; undefined (an empty cell) where the reference is
+    /// 0 and the difference is not (a curve's difference, compared absolutely).
+    pub rel_diff: Option<f64>,
     /// The bound it is held to, and whether that is absolute or relative.
     pub tolerance: f64,
     pub relative: bool,
@@ -37,7 +38,12 @@ impl Row {
         let abs_diff = (engine - reference).abs();
         let rel_diff = abs_diff / reference.abs();
         let d = if relative { rel_diff } else { abs_diff };
-        Row { case: case.into(), code, quantity: quantity.into(), engine, reference, abs_diff, rel_diff, tolerance, relative, pass: d <= tolerance }
+        Row { case: case.into(), code, quantity: quantity.into(), engine, reference, abs_diff, rel_diff: rel_diff.is_finite().then_some(rel_diff), tolerance, relative, pass: d <= tolerance }
+    }
+
+    /// The difference the bound applies to: relative (infinite where undefined) or absolute.
+    pub fn diff(&self) -> f64 {
+        if self.relative { self.rel_diff.unwrap_or(f64::INFINITY) } else { self.abs_diff }
     }
 }
 
