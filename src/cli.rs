@@ -51,6 +51,24 @@ enum Command {
         /// bit-identical to one thread.
         #[arg(long, default_value_t = 1)]
         threads: usize,
+        /// Write a checkpoint (checkpoint.bin in --out, replaced each time) every this
+        /// much simulated time, s; `grainlab resume DIR` continues the run from it, bit
+        /// for bit. A stop request (SIGINT, SIGTERM) writes one whatever this says.
+        #[arg(long, value_name = "SECONDS_SIMULATED")]
+        checkpoint_every: Option<f64>,
+    },
+    /// Continue an interrupted or killed run from its output folder's checkpoint: the
+    /// folder then holds what the run that never stopped would have written (energy.csv,
+    /// walls.csv, frames: the same bytes).
+    Resume {
+        /// The run's output folder (its --out).
+        dir: PathBuf,
+        /// No progress bar.
+        #[arg(long)]
+        quiet: bool,
+        /// Threads for the contact forces (default: the run's; the bits do not depend on it).
+        #[arg(long)]
+        threads: Option<usize>,
     },
     /// Time the thread pool's hand-over with no work (feature `parallel`): the fixed cost
     /// of every stage on several threads, on this host now. Prints JSON, nanoseconds.
@@ -215,11 +233,41 @@ fn check_duration(duration: Option<f64>) -> Result<(), Error> {
     }
 }
 
+/// What `run` and `resume` print of a run: the stage timings, a warning, the headline,
+/// then the summary on stdout; the run's error, if any.
+fn report_run(report: RunReport, out: Option<&std::path::Path>) -> Result<(), Error> {
+    let RunReport { summary, ending, write_error, unwritten } = report;
+    note!("{}", timing_table(&summary).trim_end());
+    if let Some(w) = summary.energy.as_ref().and_then(|e| e.warning.as_ref()) {
+        note!("warning: {w}");
+    }
+    // The run in one line, before the JSON.
+    note!("{}", grainlab::output::summary::headline(&summary));
+    // Always printed: when summary.json could not be written, this is its copy.
+    let printed = say!("{}", serde_json::to_string_pretty(&summary).expect("serialisable"));
+    let dir = out.unwrap_or(std::path::Path::new("")).display();
+    match (write_error, ending) {
+        (Some(failed), ending) => {
+            if let Some(end) = ending {
+                note!("error: {end}");
+            }
+            note!("error: could not write {} in {dir}; the summary is on stdout", unwritten.join(", "));
+            Err(failed)
+        }
+        (None, ending) => {
+            if out.is_some() {
+                note!("wrote {dir}");
+            }
+            ending.map_or(printed, Err)
+        }
+    }
+}
+
 fn execute(cli: Cli) -> Result<(), Error> {
     let limits = cli.memory_budget.map_or_else(Limits::machine, Limits::with_memory);
     let load_scene = |arg: &str| grainlab::scene::builtin::load(arg, &limits);
     match cli.command {
-        Command::Run { scene, out, overwrite, duration, quiet, threads } => {
+        Command::Run { scene, out, overwrite, duration, quiet, threads, checkpoint_every } => {
             let scene = load_scene(&scene)?;
             check_duration(duration)?;
             if let Some(dir) = &out {
@@ -228,33 +276,14 @@ fn execute(cli: Cli) -> Result<(), Error> {
             }
             let built = build_limited(&scene, threads, &limits)?;
             note!("{}", built.explain());
-            let opts = RunOptions { out: out.clone(), overwrite, progress: !quiet, duration, limits, stop: Some(interrupt_flag()?), command: std::env::args().collect() };
-            let RunReport { summary, ending, write_error, unwritten } = run_report(&scene, built, &opts)?;
-            note!("{}", timing_table(&summary).trim_end());
-            if let Some(w) = summary.energy.as_ref().and_then(|e| e.warning.as_ref()) {
-                note!("warning: {w}");
-            }
-            // The run in one line, before the JSON.
-            note!("{}", grainlab::output::summary::headline(&summary));
-            // Always printed: when summary.json could not be written, this is its copy.
-            let printed = say!("{}", serde_json::to_string_pretty(&summary).expect("serialisable"));
-            let dir = out.as_deref().unwrap_or(std::path::Path::new("")).display();
+            let opts = RunOptions { out: out.clone(), overwrite, progress: !quiet, duration, limits, stop: Some(interrupt_flag()?), command: std::env::args().collect(), checkpoint_every, ..RunOptions::default() };
             let _ = run_scene;
-            match (write_error, ending) {
-                (Some(failed), ending) => {
-                    if let Some(end) = ending {
-                        note!("error: {end}");
-                    }
-                    note!("error: could not write {} in {dir}; the summary is on stdout", unwritten.join(", "));
-                    Err(failed)
-                }
-                (None, ending) => {
-                    if out.is_some() {
-                        note!("wrote {dir}");
-                    }
-                    ending.map_or(printed, Err)
-                }
-            }
+            report_run(run_report(&scene, built, &opts)?, out.as_deref())
+        }
+        Command::Resume { dir, quiet, threads } => {
+            let opts = RunOptions { progress: !quiet, limits, stop: Some(interrupt_flag()?), command: std::env::args().collect(), ..RunOptions::default() };
+            note!("resuming {}", dir.display());
+            report_run(grainlab::study::run::resume(&dir, threads, &opts)?, Some(&dir))
         }
         Command::Handover { threads, samples } => {
             say!("{}", serde_json::to_string_pretty(&grainlab::kernels::threads::hand_over_summary(threads, samples)?).expect("numbers serialise"))

@@ -52,6 +52,10 @@ pub enum Error {
     /// A run ended early on request (SIGINT or SIGTERM), with everything written.
     #[error("run interrupted at step {step} (t = {time:.6e} s) on a stop request (SIGINT or SIGTERM); everything it computed is written")]
     Interrupted { step: u64, time: f64 },
+    /// A checkpoint that cannot be resumed: corrupt, truncated, of another format or
+    /// build, or of another run than its folder's.
+    #[error("checkpoint {file}: {why}")]
+    Checkpoint { file: String, why: String },
     #[error("{context}: {source}")]
     Io { context: String, source: std::io::Error },
     #[error("{0}")]
@@ -66,7 +70,7 @@ impl Error {
     /// The process exit code for this error ([`exit`]).
     pub fn exit_code(&self) -> u8 {
         match self {
-            Error::Invalid { .. } | Error::Scene(_) | Error::Parse { .. } | Error::BadOption { .. } | Error::Folder { .. } | Error::Export(_) => exit::BAD_INPUT,
+            Error::Invalid { .. } | Error::Scene(_) | Error::Parse { .. } | Error::BadOption { .. } | Error::Folder { .. } | Error::Export(_) | Error::Checkpoint { .. } => exit::BAD_INPUT,
             Error::Io { .. } => exit::IO_FAILURE,
             Error::Unstable { .. } => exit::UNSTABLE,
             Error::Interrupted { .. } => exit::INTERRUPTED,

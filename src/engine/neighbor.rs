@@ -46,6 +46,14 @@ impl Neighbours {
         self.x_at_build.len() != n || self.moved_far
     }
 
+    /// Take the state a checkpoint saved: the positions at the last build, the number of
+    /// builds, and whether a grain has moved far since ([`crate::engine::snapshot`]).
+    pub fn restore(&mut self, at_build: Vec<Vec2>, builds: u64, moved_far: bool) {
+        self.x_at_build = at_build;
+        self.builds = builds;
+        self.moved_far = moved_far;
+    }
+
     /// Build the pair list with the cell list.
     pub fn build(&mut self, x: &[Vec2], r: &[f64], n_free: usize, boundary: &Boundary, threads: &Threads) -> Vec<[u32; 2]> {
         self.builds += 1;

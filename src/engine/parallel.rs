@@ -374,6 +374,12 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN: bool> Stage<Con
     fn name(&self) -> String {
         format!("PairContacts(parallel, {} threads)", self.scratch.len())
     }
+    /// Nothing carried: the tables are cut again for the restored list (where the ranges
+    /// are cut changes no bit of the results).
+    fn restore(&mut self, carried: &[f64]) -> Result<(), String> {
+        self.built_for = u64::MAX;
+        if carried.is_empty() { Ok(()) } else { Err(format!("the parallel contact stage carries nothing, the checkpoint gave it {} numbers", carried.len())) }
+    }
     fn run(&mut self, w: &mut World<ContactModel<Dm, T>>) -> Result<(), Error> {
         let (n, n_free) = (w.p.len(), w.p.n_free);
         let np = w.pairs.pairs.len();

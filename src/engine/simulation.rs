@@ -66,6 +66,13 @@ impl<L: ContactLaw> Simulation<L> {
     pub fn stage_names(&self) -> Vec<String> {
         self.stages.iter().map(|s| s.name()).collect()
     }
+    /// The stages in order.
+    pub fn stages(&self) -> &[Box<dyn Stage<L>>] {
+        &self.stages
+    }
+    pub(crate) fn stages_mut(&mut self) -> &mut [Box<dyn Stage<L>>] {
+        &mut self.stages
+    }
     /// Time spent in each stage so far.
     pub fn timings(&self) -> Vec<(String, Duration)> {
         self.stage_names().into_iter().zip(self.timers.iter().cloned()).collect()
@@ -134,6 +141,12 @@ pub trait Engine: Send {
     fn health(&self) -> Result<(), Error>;
     /// Change the walls' motion and gravity between two steps ([`Simulation::change_motion`]).
     fn change_motion(&mut self, c: &MotionChange);
+    /// Everything the simulation carries from step to step, encoded
+    /// ([`crate::engine::snapshot`]).
+    fn save(&self) -> Vec<u8>;
+    /// Take a state [`Engine::save`] encoded, of a simulation built from the same scene;
+    /// an error says what does not fit.
+    fn restore(&mut self, bytes: &[u8]) -> Result<(), String>;
     /// A read-only view of the state, what observers and outputs read.
     fn view(&self) -> View<'_> {
         View { particles: self.particles(), walls: self.walls(), boundary: self.boundary(), time: self.time() }
@@ -191,5 +204,11 @@ impl<L: ContactLaw> Engine for Simulation<L> {
     }
     fn change_motion(&mut self, c: &MotionChange) {
         Simulation::change_motion(self, c)
+    }
+    fn save(&self) -> Vec<u8> {
+        Simulation::save(self)
+    }
+    fn restore(&mut self, bytes: &[u8]) -> Result<(), String> {
+        Simulation::restore(self, bytes)
     }
 }

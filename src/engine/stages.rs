@@ -151,6 +151,19 @@ impl<L: ContactLaw, const ENERGY: bool> Stage<L> for GeneralDamping<ENERGY> {
         }
         Ok(())
     }
+    /// The previous step's damping forces and torques (for the trapezoid rule): x, y
+    /// and the torque of each grain.
+    fn carried(&self) -> Vec<f64> {
+        self.prev_f.iter().zip(&self.prev_m).flat_map(|(f, &m)| [f.x, f.y, m]).collect()
+    }
+    fn restore(&mut self, carried: &[f64]) -> Result<(), String> {
+        if !carried.len().is_multiple_of(3) {
+            return Err(format!("{}: {} numbers, not three per grain", <Self as Stage<L>>::name(self), carried.len()));
+        }
+        self.prev_f = carried.chunks_exact(3).map(|c| Vec2::new(c[0], c[1])).collect();
+        self.prev_m = carried.chunks_exact(3).map(|c| c[2]).collect();
+        Ok(())
+    }
 }
 
 /// Grain-grain contacts over the Verlet list, in two passes: a branch-free sweep sorts

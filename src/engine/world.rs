@@ -227,6 +227,17 @@ pub struct View<'a> {
 pub trait Stage<L: ContactLaw>: Send {
     fn name(&self) -> String;
     fn run(&mut self, w: &mut World<L>) -> Result<(), Error>;
+    /// What the stage carries from one step to the next that its results depend on, for
+    /// a checkpoint ([`crate::engine::snapshot`]); most stages carry nothing.
+    fn carried(&self) -> Vec<f64> {
+        Vec::new()
+    }
+    /// Take what [`Stage::carried`] gave, into a stage built from the same scene, and
+    /// forget what it derived from the world it had (the world is now another): an error
+    /// says what does not fit.
+    fn restore(&mut self, carried: &[f64]) -> Result<(), String> {
+        if carried.is_empty() { Ok(()) } else { Err(format!("{} carries nothing here, the checkpoint gave it {} numbers", self.name(), carried.len())) }
+    }
 }
 
 /// The half-kick factors `dt/2 / m` and `dt/2 / I` of the free grains, divided out once

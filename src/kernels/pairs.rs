@@ -81,6 +81,31 @@ impl<H: Copy + Default + Send + Sync> PairList<H> {
         self.pairs = Pairs { top: new_pairs.iter().fold(0, |t, p| t.max(p[0].max(p[1]) as usize + 1)), list: new_pairs };
         self.spare = Spare { hist: std::mem::replace(&mut self.hist, hist), active: std::mem::replace(&mut self.active, active), energy: std::mem::replace(&mut self.energy, energy) };
     }
+    /// Take a list a checkpoint saved: sorted pairs (i < j, each grain index below `r`'s
+    /// length, checked) and their states, parallel to them; the constants are computed
+    /// again from the radii `r` and masses `m`, as the build computed them. An error
+    /// says what does not fit.
+    pub fn restore(&mut self, pairs: Vec<[u32; 2]>, hist: Vec<H>, active: Vec<bool>, energy: Vec<EnergyMemory>, r: &[f64], m: &[f64]) -> Result<(), String> {
+        let np = pairs.len();
+        if hist.len() != np || active.len() != np || energy.len() != if self.keep_energy { np } else { 0 } {
+            return Err(format!("its pair list has {np} pairs but {} histories, {} flags and {} energy memories", hist.len(), active.len(), energy.len()));
+        }
+        let n = r.len().min(m.len());
+        if let Some(p) = pairs.iter().find(|p| p[0] >= p[1] || p[1] as usize >= n) {
+            return Err(format!("its pair list holds the pair {p:?}, not of two of its {n} grains in order"));
+        }
+        if pairs.windows(2).any(|w| w[0] >= w[1]) {
+            return Err("its pair list is not sorted".into());
+        }
+        self.consts = vec![PairConst::default(); np];
+        self.reach = vec![0.0; np];
+        constants(&pairs, &mut self.consts, &mut self.reach, r, m);
+        self.pairs = Pairs { top: pairs.iter().fold(0, |t, p| t.max(p[1] as usize + 1)), list: pairs };
+        self.hist = hist;
+        self.active = active;
+        self.energy = energy;
+        Ok(())
+    }
     /// The energy sums of every listed pair, added in list order
     /// ([`EnergySums::total`]); zero without the energy ledger.
     pub fn energy_sums(&self) -> EnergySums {

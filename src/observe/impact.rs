@@ -5,7 +5,7 @@
 //! steps, and the peaks of overlap and force by a parabola through the three samples
 //! around the largest, so that the measurement error is far below one time step.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::engine::world::View;
 use crate::physics::dim::Vec2;
@@ -48,7 +48,7 @@ pub struct ImpactSummary {
     pub momentum_error_rel: f64,
 }
 
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Copy, Debug, Default, Serialize, Deserialize)]
 struct Contact {
     n: Vec2,
     overlap: f64,
@@ -58,7 +58,7 @@ struct Contact {
 }
 
 /// The impact observer.
-#[derive(Debug, Default)]
+#[derive(Debug, Default, Serialize, Deserialize)]
 pub struct ImpactObserver {
     before: Option<Contact>,
     prev: Option<(f64, Contact)>,

@@ -8,7 +8,7 @@
 //! Their ratio is undefined (written as an empty cell, `null` in JSON) while sigma is zero,
 //! e.g. before any grain touches a wall.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::engine::world::View;
 use crate::observe::stats::{Estimate, block_average};
@@ -30,7 +30,7 @@ pub struct WallRow {
 }
 
 /// Averages the wall forces over every step of a sample interval.
-#[derive(Debug, Default)]
+#[derive(Debug, Default, Serialize, Deserialize)]
 pub struct WallAverager {
     sum: [Vec2; 2],
     n: u64,

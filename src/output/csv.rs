@@ -111,6 +111,41 @@ impl CsvSeries {
         self.out.write_all(&bytes).and_then(|()| self.out.flush()).map_err(|e| Error::io(self.path.display(), e))
     }
 
+    /// Continue the staged series `path` (its `path.part`, or `path` itself if a run that
+    /// ended renamed it: renamed back) from its first `bytes` bytes, what a checkpoint
+    /// recorded; what follows them (rows written after the checkpoint) is cut off. An
+    /// error if the file is missing or shorter.
+    pub fn resume(path: &Path, bytes: u64) -> Result<Self, Error> {
+        let part = with_suffix(path, PART_SUFFIX);
+        if !part.exists() && path.exists() {
+            std::fs::rename(path, &part).map_err(|e| Error::io(part.display(), e))?;
+        }
+        let mut file = std::fs::OpenOptions::new().read(true).write(true).open(&part).map_err(|e| Error::io(part.display(), e))?;
+        let len = file.metadata().map_err(|e| Error::io(part.display(), e))?.len();
+        if len < bytes {
+            return Err(Error::Checkpoint { file: part.display().to_string(), why: format!("holds {len} bytes, the checkpoint needs its first {bytes}: it was cut after the checkpoint was written") });
+        }
+        file.set_len(bytes).map_err(|e| Error::io(part.display(), e))?;
+        let mut crc = crc32fast::Hasher::new();
+        let mut kept = Vec::new();
+        std::io::Read::read_to_end(&mut file, &mut kept).map_err(|e| Error::io(part.display(), e))?;
+        crc.update(&kept);
+        use std::io::Seek as _;
+        file.seek(std::io::SeekFrom::End(0)).map_err(|e| Error::io(part.display(), e))?;
+        let out = Counted { file, bytes, crc };
+        Ok(CsvSeries { out, path: part, final_path: Some(path.to_path_buf()), header: bytes > 0 })
+    }
+
+    /// Bytes written so far, on disk (rows are flushed as written); with `sync`, after
+    /// asking the system to put them on the disk itself (a checkpoint refers to them).
+    pub fn written(&mut self, sync: bool) -> Result<u64, Error> {
+        self.out.flush().map_err(|e| Error::io(self.path.display(), e))?;
+        if sync {
+            self.out.file.sync_data().map_err(|e| Error::io(self.path.display(), e))?;
+        }
+        Ok(self.out.bytes)
+    }
+
     /// Flush, rename a staged series to its name, and return its size and CRC-32.
     pub fn finish(mut self) -> Result<(u64, u32), Error> {
         self.out.flush().map_err(|e| Error::io(self.path.display(), e))?;

@@ -77,8 +77,16 @@ pub struct OutFolder {
 /// Write `bytes` to `path` under a temporary name in the same folder, then rename it:
 /// `path` holds either its old content or all of the new one.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), Error> {
+    write_whole(path, bytes, false)
+}
+
+/// [`write_atomic`], with the content on the disk itself before the rename (`sync`): a
+/// machine that stops too leaves the old content or all of the new.
+fn write_whole(path: &Path, bytes: &[u8], sync: bool) -> Result<(), Error> {
     let tmp = with_suffix(path, TEMP_SUFFIX);
-    let written = std::fs::File::create(&tmp).and_then(|mut f| f.write_all(bytes)).and_then(|()| std::fs::rename(&tmp, path));
+    let written = std::fs::File::create(&tmp)
+        .and_then(|mut f| f.write_all(bytes).and_then(|()| if sync { f.sync_all() } else { Ok(()) }))
+        .and_then(|()| std::fs::rename(&tmp, path));
     written.map_err(|e| {
         let _ = std::fs::remove_file(&tmp);
         Error::io(path.display(), e)
@@ -247,6 +255,46 @@ impl OutFolder {
         Ok(folder)
     }
 
+    /// Take back the folder of a run that did not complete, to resume it: its manifest
+    /// must be grainlab's and its status not `completed`. The status goes back to
+    /// `running`, and the files a resumed run writes again at its end (`summary.json`,
+    /// `force_overlap.csv`) and the frames past the first `frames` of `frames_kept` are
+    /// deleted and unlisted, so that nothing in the folder mixes the two runs.
+    pub fn reopen(dir: &Path, frames_kept: &[String]) -> Result<Self, Error> {
+        let refuse = |why: String| Err(Error::Folder { dir: dir.display().to_string(), why });
+        let manifest: Option<Manifest> =
+            crate::scene::limits::read_bounded(&dir.join(MANIFEST), MAX_MANIFEST_BYTES, MANIFEST).ok().and_then(|t| serde_json::from_str(&t).ok()).filter(|m: &Manifest| m.format == FORMAT);
+        let Some(mut manifest) = manifest else {
+            return refuse(format!("has no {MANIFEST} of grainlab's: it is not a run's output folder"));
+        };
+        if manifest.status == "completed" {
+            return refuse(format!("holds a completed `grainlab {}`: nothing to resume", manifest.command));
+        }
+        let gone = |p: &str| p == "summary.json" || p == "force_overlap.csv" || p == "force_overlap.csv.part" || (p.starts_with("frames/") && !frames_kept.iter().any(|f| f == p));
+        for f in manifest.files.iter().filter(|f| gone(&f.path)) {
+            let path = dir.join(&f.path);
+            match std::fs::remove_file(&path) {
+                Err(e) if e.kind() != std::io::ErrorKind::NotFound => return Err(Error::io(path.display(), e)),
+                _ => {}
+            }
+        }
+        manifest.files.retain(|f| !gone(&f.path));
+        manifest.status = "running".into();
+        let folder = OutFolder { dir: dir.to_path_buf(), manifest };
+        folder.save()?;
+        Ok(folder)
+    }
+
+    /// Continue the series `rel` from its first `bytes` bytes ([`CsvSeries::resume`]),
+    /// listed as `rel.part` until [`OutFolder::close_series`].
+    pub fn resume_series(&mut self, rel: &str, bytes: u64) -> Result<CsvSeries, Error> {
+        self.announce(&format!("{rel}{PART_SUFFIX}"))?;
+        let s = CsvSeries::resume(&self.dir.join(rel), bytes)?;
+        self.manifest.files.retain(|f| f.path != rel);
+        self.save()?;
+        Ok(s)
+    }
+
     pub fn dir(&self) -> &Path {
         &self.dir
     }
@@ -290,8 +338,17 @@ impl OutFolder {
 
     /// Write the whole file `rel` atomically, listed first.
     pub fn write(&mut self, rel: &str, bytes: &[u8]) -> Result<(), Error> {
+        self.write_with(rel, bytes, false)
+    }
+
+    /// [`OutFolder::write`], synced to the disk before the rename (a checkpoint).
+    pub fn write_synced(&mut self, rel: &str, bytes: &[u8]) -> Result<(), Error> {
+        self.write_with(rel, bytes, true)
+    }
+
+    fn write_with(&mut self, rel: &str, bytes: &[u8], sync: bool) -> Result<(), Error> {
         let path = self.announce(rel)?;
-        write_atomic(&path, bytes)?;
+        write_whole(&path, bytes, sync)?;
         self.record(rel, bytes.len() as u64, crc32fast::hash(bytes));
         Ok(())
     }
@@ -319,6 +376,17 @@ impl OutFolder {
             w.row(r)?;
         }
         self.close_series(w, rel)
+    }
+
+    /// Delete the file `rel`, if there, and unlist it.
+    pub fn remove(&mut self, rel: &str) -> Result<(), Error> {
+        let path = self.dir.join(rel);
+        match std::fs::remove_file(&path) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => return Err(Error::io(path.display(), e)),
+            _ => {}
+        }
+        self.manifest.files.retain(|f| f.path != rel);
+        Ok(())
     }
 
     /// Write the final manifest with `status` (files that were announced and never

@@ -4,6 +4,7 @@
 //! every file appears whole). May use: `observe`, `engine` (its view),
 //! `scene`, `physics`, `error`, `finite`.
 
+pub mod checkpoint;
 pub mod csv;
 pub mod folder;
 pub mod provenance;

@@ -34,6 +34,9 @@ pub struct Provenance {
     pub ended_utc: String,
     /// The scene as run, in the output folder (none without one).
     pub scene_file: Option<String>,
+    /// The steps at which the run was resumed from a checkpoint (`grainlab resume`), in
+    /// order; `started_utc` is the first part's start.
+    pub resumed_at_steps: Vec<u64>,
 }
 
 impl Provenance {
@@ -49,6 +52,7 @@ impl Provenance {
             started_utc: utc(started),
             ended_utc: String::new(),
             scene_file,
+            resumed_at_steps: Vec::new(),
         }
     }
     /// Note the end of the run, now.

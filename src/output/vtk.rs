@@ -27,6 +27,23 @@ impl VtkSeries {
         Ok(VtkSeries { frames: Vec::new() })
     }
 
+    /// Continue a series whose first frames are `frames` (time, file), as a checkpoint
+    /// recorded them ([`VtkSeries::frames`]): the `.pvd` index is written again with
+    /// those only (a run stopped after the checkpoint may have listed more).
+    pub fn resume(frames: Vec<(f64, String)>, folder: &mut OutFolder) -> Result<Self, Error> {
+        folder.folder("frames")?;
+        let s = VtkSeries { frames };
+        if !s.frames.is_empty() {
+            s.index(folder)?;
+        }
+        Ok(s)
+    }
+
+    /// The frames written so far: time, s, and file.
+    pub fn frames(&self) -> &[(f64, String)] {
+        &self.frames
+    }
+
     /// Write one frame and rewrite the `.pvd` index (each a whole file, listed in the
     /// folder's manifest).
     pub fn frame(&mut self, e: &View, folder: &mut OutFolder) -> Result<(), Error> {
@@ -63,6 +80,11 @@ impl VtkSeries {
         let name = format!("frames/grains_{:05}.vtp", self.frames.len());
         folder.write(&name, s.as_bytes())?;
         self.frames.push((e.time, name));
+        self.index(folder)
+    }
+
+    /// Write the `.pvd` index of the frames.
+    fn index(&self, folder: &mut OutFolder) -> Result<(), Error> {
         let mut pvd = String::from("<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n  <Collection>\n");
         for (t, f) in &self.frames {
             let _ = writeln!(pvd, "    <DataSet timestep=\"{t:e}\" part=\"0\" file=\"{f}\"/>");

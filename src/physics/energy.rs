@@ -27,10 +27,10 @@
 //! The sums are therefore the same on any number of threads, and the kernel adds to
 //! nothing that another pair adds to.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// Running totals, J. Dissipations are positive when energy leaves the grains.
-#[derive(Clone, Copy, Debug, Default, Serialize, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, Serialize, Deserialize, PartialEq)]
 pub struct EnergyLedger {
     /// Energy dissipated by normal damping (and by the clamp, if any), J.
     pub normal_damping: f64,
@@ -80,7 +80,7 @@ impl EnergyLedger {
 
 /// What one contact has added to the ledger since its sums were last taken (per lane:
 /// of four contacts), J: dissipations positive, as in [`EnergyLedger`].
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct EnergySums<R = f64> {
     /// Dissipated by normal damping (and by the clamp, if any), J.
     pub normal_damping: R,
@@ -119,7 +119,7 @@ impl EnergySums {
 }
 
 /// One row of the energy time series, J.
-#[derive(Clone, Copy, Debug, Default, Serialize)]
+#[derive(Clone, Copy, Debug, Default, Serialize, Deserialize)]
 pub struct EnergyRow {
     pub time_s: f64,
     pub kinetic_translation_j: f64,

@@ -19,7 +19,7 @@ pub enum Surface {
 }
 
 /// How the wall moves in y.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum Control {
     /// Held at its position (fixed gap).
     Fixed,

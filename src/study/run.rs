@@ -2,12 +2,13 @@
 //! stage timing table.
 
 use std::io::Write as _;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressStyle};
+use serde::{Deserialize, Serialize};
 
 use crate::engine::build::Built;
 use crate::engine::simulation::Engine;
@@ -18,6 +19,7 @@ use crate::error::Error;
 use crate::observe::energy::energy_summary;
 use crate::observe::impact::ImpactObserver;
 use crate::observe::stress::{ShearSummary, WallAverager, WallRow, stress_estimates};
+use crate::output::checkpoint::{CHECKPOINT, Checkpoint};
 use crate::output::csv::CsvSeries;
 use crate::output::folder::OutFolder;
 use crate::output::provenance::{Provenance, RESOLVED_SCENE, resolved};
@@ -46,6 +48,14 @@ pub struct RunOptions {
     pub stop: Option<Arc<AtomicBool>>,
     /// The command line that started the run, for its provenance (empty from the library).
     pub command: Vec<String>,
+    /// Simulated time between checkpoints (`--checkpoint-every`), s: `checkpoint.bin` in
+    /// the output folder (needed) is replaced at every step that is a multiple of the
+    /// rate rounded to steps, and `grainlab resume` continues from it bit for bit. With
+    /// an output folder, a stop request writes one too, whatever the rate. Default: none.
+    pub checkpoint_every: Option<f64>,
+    /// End the run after this step as a stop request would (checkpointed, `interrupted`):
+    /// a run cut into parts of a known length, and the restart tests' stops.
+    pub stop_after_step: Option<u64>,
 }
 
 
@@ -107,12 +117,171 @@ pub fn run_built(scene: &Scene, built: Built, opts: &RunOptions) -> Result<Summa
 
 /// Run an engine built from `scene` and report how it ended ([`RunReport`]). An error
 /// here means the run did not start (its output folder refused or not writable).
-pub fn run_report(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<RunReport, Error> {
+pub fn run_report(scene: &Scene, built: Built, opts: &RunOptions) -> Result<RunReport, Error> {
+    drive(scene, built, opts, None)
+}
+
+/// Continue the run whose output folder is `dir` from its checkpoint ([`CHECKPOINT`]),
+/// on `threads` (default: the run's), with `opts`' progress, stop flag, limits and
+/// command (its folder, duration and checkpoint rate are the run's). The resumed run
+/// writes energy.csv, walls.csv and the frames byte for byte as the run that never
+/// stopped would have (`tests/restart.rs`). Refused, with nothing changed in `dir`, if
+/// the checkpoint is damaged, of another build or format, or of another run than the
+/// folder's scene.
+pub fn resume(dir: &Path, threads: Option<usize>, opts: &RunOptions) -> Result<RunReport, Error> {
+    let file = dir.join(CHECKPOINT);
+    let c = Checkpoint::read(&file, opts.limits.memory_bytes)?;
+    let shown = file.display().to_string();
+    let refuse = |why: String| Err(Error::Checkpoint { file: shown.clone(), why });
+    if (c.grainlab.as_str(), c.commit.as_str()) != (env!("CARGO_PKG_VERSION"), env!("GRAINLAB_COMMIT")) {
+        return refuse(format!(
+            "was written by grainlab {} (commit {}), this is {} (commit {}): a run resumes bit for bit only on the build that started it",
+            c.grainlab,
+            c.commit,
+            env!("CARGO_PKG_VERSION"),
+            env!("GRAINLAB_COMMIT")
+        ));
+    }
+    let scene = Scene::from_json(&c.scene)?;
+    let run_scene = c.duration.map_or_else(|| scene.clone(), |d| scene.truncated(d));
+    let theirs = crate::scene::limits::read_bounded(&dir.join(RESOLVED_SCENE), opts.limits.file_bytes(), RESOLVED_SCENE)?;
+    if theirs != resolved_json(&run_scene) {
+        return refuse(format!("belongs to another run than this folder's {RESOLVED_SCENE} (the scenes differ)"));
+    }
+    let state: LoopState = match postcard::from_bytes(&c.run) {
+        Ok(s) => s,
+        Err(e) => return refuse(format!("its run state does not decode ({e})")),
+    };
+    let mut built = crate::study::accuracy::build_limited(&scene, threads.unwrap_or(c.threads), &opts.limits)?;
+    if let Err(why) = built.engine.restore(&c.engine) {
+        return refuse(why);
+    }
+    // Everything checked: the folder is taken back and its series cut to the checkpoint.
+    let mut folder = OutFolder::reopen(dir, &state.frames.iter().map(|f| f.1.clone()).collect::<Vec<_>>())?;
+    let energy = state.energy_bytes.map(|b| folder.resume_series("energy.csv", b)).transpose()?;
+    let walls = state.walls_bytes.map(|b| folder.resume_series("walls.csv", b)).transpose()?;
+    let vtk = if state.frames_on { Some(VtkSeries::resume(state.frames.clone(), &mut folder)?) } else { None };
+    let opts = RunOptions { out: Some(dir.to_path_buf()), duration: c.duration, checkpoint_every: opts.checkpoint_every.or(c.every_s), ..opts.clone() };
+    let outputs = Outputs { folder: Some(folder), energy, walls, vtk };
+    drive(&scene, built, &opts, Some((outputs, state)))
+}
+
+/// The resolved scene's file as a run writes it.
+fn resolved_json(scene: &Scene) -> String {
+    serde_json::to_string_pretty(&resolved(scene, scene.duration)).expect("serialisable") + "\n"
+}
+
+/// What the run loop carries besides the engine, saved in a checkpoint: the observers'
+/// accumulators, the rows so far, what the outputs hold, and the run's clock.
+#[derive(Default, Serialize, Deserialize)]
+struct LoopState {
+    walls_avg: WallAverager,
+    wall_rows: Vec<WallRow>,
+    /// The rows each stage ended at (an index into `wall_rows`), as the stages end.
+    stage_ends: Vec<usize>,
+    /// The largest energy residual so far, as a fraction of the energy put in.
+    max_res: f64,
+    /// The last energy row recorded (of a state that passed its checks): the summary's,
+    /// so that a run stopped on a state gone wrong reports the last one that was not.
+    last_row: Option<EnergyRow>,
+    impact: Option<ImpactObserver>,
+    /// Bytes of energy.csv and walls.csv written (none: the run writes no such series).
+    energy_bytes: Option<u64>,
+    walls_bytes: Option<u64>,
+    /// The run writes frames, and those written (time, s; file).
+    frames_on: bool,
+    frames: Vec<(f64, String)>,
+    /// When the run started (seconds since the Unix epoch), and the wall-clock time its
+    /// earlier parts took, s.
+    started_unix_s: f64,
+    wall_time_s: f64,
+    /// Steps at which the run was resumed.
+    resumed: Vec<u64>,
+}
+
+impl LoopState {
+    /// Record the energy balance now (with the ledger on): its residual, and a row of
+    /// energy.csv.
+    fn record_energy(&mut self, e: &dyn Engine, out: &mut Outputs, stage: &str, energy_on: bool) -> Result<(), Error> {
+        if energy_on {
+            let row = e.energy_row();
+            self.max_res = self.max_res.max(row.residual_j.abs() / row.put_in().max(f64::MIN_POSITIVE));
+            self.last_row = Some(row);
+            if let Some(w) = out.energy.as_mut() {
+                w.row_in(stage, &row)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Record a sample: the energy row and the walls' row (forces averaged since the last).
+    fn sample(&mut self, e: &dyn Engine, out: &mut Outputs, stage: &str, energy_on: bool, length: f64, depth: f64) -> Result<(), Error> {
+        self.record_energy(e, out, stage, energy_on)?;
+        if let Some(row) = self.walls_avg.row(&e.view(), length, depth) {
+            if let Some(w) = out.walls.as_mut() {
+                w.row_in(stage, &row)?;
+            }
+            self.wall_rows.push(row);
+        }
+        Ok(())
+    }
+}
+
+/// What a checkpoint records besides the states: the run's scene as built, its
+/// `--duration`, and the rate.
+struct Checkpointing {
+    scene: String,
+    duration: Option<f64>,
+    every_s: Option<f64>,
+    /// Steps between checkpoints (none: only a stop request writes one).
+    every: Option<u64>,
+}
+
+impl Checkpointing {
+    /// Write `checkpoint.bin` for the state after this step: the series flushed and synced
+    /// first (the checkpoint holds their lengths), then the checkpoint, synced and renamed.
+    fn write(&self, e: &dyn Engine, out: &mut Outputs, st: &mut LoopState, wall_time_s: f64) -> Result<(), Error> {
+        let Some(folder) = out.folder.as_mut() else { return Ok(()) };
+        st.energy_bytes = out.energy.as_mut().map(|s| s.written(true)).transpose()?;
+        st.walls_bytes = out.walls.as_mut().map(|s| s.written(true)).transpose()?;
+        st.frames = out.vtk.as_ref().map(|v| v.frames().to_vec()).unwrap_or_default();
+        let before = std::mem::replace(&mut st.wall_time_s, wall_time_s);
+        let run = postcard::to_stdvec(&*st).expect("the run state encodes");
+        st.wall_time_s = before;
+        let c = Checkpoint {
+            grainlab: env!("CARGO_PKG_VERSION").into(),
+            commit: env!("GRAINLAB_COMMIT").into(),
+            scene: self.scene.clone(),
+            duration: self.duration,
+            threads: e.threads(),
+            every_s: self.every_s,
+            step: e.steps(),
+            time_s: e.time(),
+            engine: e.save(),
+            run,
+        };
+        folder.write_synced(CHECKPOINT, &c.encode())
+    }
+}
+
+/// The run loop, from the start or (`resumed`: the outputs reopened and the loop's state;
+/// the engine restored) from a checkpoint.
+fn drive(scene: &Scene, mut built: Built, opts: &RunOptions, resumed: Option<(Outputs, LoopState)>) -> Result<RunReport, Error> {
     let duration = opts.duration.unwrap_or(scene.duration);
     let dt = built.time_step.dt_s;
     // The build checked the scene's duration; an override is checked here, and cuts a
     // protocol short.
     step_count(duration, dt, if opts.duration.is_some() { "--duration" } else { "duration" })?;
+    let every = match opts.checkpoint_every {
+        None => None,
+        Some(s) => {
+            crate::error::check_option(s.is_finite() && s > 0.0, "--checkpoint-every", s, "> 0 s of simulated time")?;
+            crate::error::check_option(opts.out.is_some(), "--checkpoint-every", s, "with an output folder (--out) to write the checkpoints in")?;
+            Some(((s / dt).round() as u64).max(1))
+        }
+    };
+    let checkpointing = Checkpointing { scene: String::new(), duration: opts.duration, every_s: opts.checkpoint_every, every };
+    let checkpointing = Checkpointing { scene: if opts.out.is_some() { serde_json::to_string(&resolved(scene, scene.duration)).expect("serialisable") } else { String::new() }, ..checkpointing };
     let cut;
     let scene = if opts.duration.is_some() {
         cut = scene.truncated(duration);
@@ -123,53 +292,53 @@ pub fn run_report(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<
     let phases = phases(scene, dt, built.length, built.depth)?;
     let total = phases.last().map_or(0, Phase::last);
     let energy_on = scene.output.energy;
-    let started = std::time::SystemTime::now();
-    let mut outputs = Outputs { folder: None, energy: None, walls: None, vtk: None };
-    if let Some(dir) = &opts.out {
-        let mut folder = OutFolder::claim(dir, opts.overwrite, &format!("run {}", scene.name))?;
-        // The scene as it runs: the folder alone repeats the run.
-        folder.write(RESOLVED_SCENE, (serde_json::to_string_pretty(&resolved(scene, scene.duration)).expect("serialisable") + "\n").as_bytes())?;
-        if energy_on {
-            outputs.energy = Some(folder.series("energy.csv")?);
+    let now = std::time::SystemTime::now();
+    let fresh = resumed.is_none();
+    let (mut outputs, mut st) = match resumed {
+        Some((outputs, mut st)) => {
+            st.resumed.push(built.engine.steps());
+            (outputs, st)
         }
-        if !built.engine.walls().is_empty() {
-            outputs.walls = Some(folder.series("walls.csv")?);
+        None => {
+            let mut outputs = Outputs { folder: None, energy: None, walls: None, vtk: None };
+            if let Some(dir) = &opts.out {
+                let mut folder = OutFolder::claim(dir, opts.overwrite, &format!("run {}", scene.name))?;
+                // The scene as it runs: the folder alone repeats the run.
+                folder.write(RESOLVED_SCENE, resolved_json(scene).as_bytes())?;
+                if energy_on {
+                    outputs.energy = Some(folder.series("energy.csv")?);
+                }
+                if !built.engine.walls().is_empty() {
+                    outputs.walls = Some(folder.series("walls.csv")?);
+                }
+                if phases.iter().any(|p| p.frame_every.is_some()) {
+                    outputs.vtk = Some(VtkSeries::new(&mut folder)?);
+                }
+                outputs.folder = Some(folder);
+            }
+            let st = LoopState {
+                frames_on: outputs.vtk.is_some(),
+                impact: (scene.analysis == Analysis::Impact).then(ImpactObserver::default),
+                started_unix_s: now.duration_since(std::time::UNIX_EPOCH).map_or(0.0, |d| d.as_secs_f64()),
+                ..LoopState::default()
+            };
+            (outputs, st)
         }
-        if phases.iter().any(|p| p.frame_every.is_some()) {
-            outputs.vtk = Some(VtkSeries::new(&mut folder)?);
-        }
-        outputs.folder = Some(folder);
-    }
+    };
+    let started = std::time::UNIX_EPOCH + std::time::Duration::from_secs_f64(st.started_unix_s);
     let pipeline = built.explain();
     let e = built.engine.as_mut();
-    let mut impact = (scene.analysis == Analysis::Impact).then(ImpactObserver::default);
-    if let Some(o) = impact.as_mut() {
-        o.start(&e.view());
-    }
-    let mut walls_avg = WallAverager::default();
-    let mut wall_rows: Vec<WallRow> = Vec::new();
-    // The rows each stage ended at (an index into `wall_rows`), as the stages end.
-    let mut stage_ends: Vec<usize> = Vec::new();
-    let mut max_res: f64 = 0.0;
-    let mut energy_rows = 0usize;
-    // The last row recorded (of a state that passed its checks): the summary's, so that a
-    // run stopped on a state gone wrong reports the last one that was not.
-    let mut last_row: Option<EnergyRow> = None;
-    let mut record_energy = |e: &dyn Engine, out: &mut Outputs, stage: &str| -> Result<(), Error> {
-        if energy_on {
-            let row = e.energy_row();
-            max_res = max_res.max(row.residual_j.abs() / row.put_in().max(f64::MIN_POSITIVE));
-            energy_rows += 1;
-            last_row = Some(row);
-            if let Some(w) = out.energy.as_mut() {
-                w.row_in(stage, &row)?;
-            }
-        }
-        Ok(())
-    };
-    // Why the run stops early, if it does, and the first output that failed besides.
+    // Where the run starts: step 0, or the checkpoint's step.
+    let k0 = e.steps();
     let first_stage = phases.first().map_or("", |p| p.name.as_str());
-    let mut error: Option<Error> = record_energy(e, &mut outputs, first_stage).and_then(|()| outputs.frame(e)).err();
+    // Why the run stops early, if it does, and the first output that failed besides.
+    let mut error: Option<Error> = None;
+    if fresh {
+        if let Some(o) = st.impact.as_mut() {
+            o.start(&e.view());
+        }
+        error = st.record_energy(e, &mut outputs, first_stage, energy_on).and_then(|()| outputs.frame(e)).err();
+    }
     let mut write_error: Option<Error> = None;
     let mut unwritten: Vec<String> = Vec::new();
     // An output that cannot be written stops the run; what it computed is summarised.
@@ -193,37 +362,49 @@ pub fn run_report(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<
     let stop = opts.stop.as_deref();
     use std::io::IsTerminal as _;
     let lines = opts.progress && !std::io::stderr().is_terminal();
-    let mut next_line = 1;
+    let mut next_line = k0 * 10 / total.max(1) + 1;
     let bar = if opts.progress && !lines {
         let b = ProgressBar::new(total);
         b.set_style(ProgressStyle::with_template("{msg} [{bar:40}] {percent}% {elapsed_precise} eta {eta}").expect("template").progress_chars("=> "));
         b.set_message(scene.name.clone());
+        b.set_position(k0);
+        b.reset_eta();
         Some(b)
     } else {
         None
     };
     let t0 = Instant::now();
+    let (length, depth) = (built.length, built.depth);
     let phases_run: &[Phase] = if error.is_none() { &phases } else { &[] };
-    'run: for phase in phases_run {
+    // The phase the run is in (its index), for a stage cut short.
+    let mut reached = 0;
+    'run: for (index, phase) in phases_run.iter().enumerate() {
+        // A resumed run skips the phases done, and the change of the one it is in.
+        if phase.last() <= k0 {
+            continue;
+        }
+        reached = index;
         let stage = phase.name.as_str();
-        if phase.change != MotionChange::default() {
+        if phase.first >= k0 && phase.change != MotionChange::default() {
             e.change_motion(&phase.change);
         }
         let shown = if stage.is_empty() { scene.name.clone() } else { format!("{} [{stage}]", scene.name) };
-        for j in 1..=phase.steps {
+        for j in (k0.max(phase.first) - phase.first + 1)..=phase.steps {
             let k = phase.first + j;
-            // A stop request makes this step the last, sampled like the last of the run.
-            let stopping = stop.is_some_and(|s| s.load(Ordering::Relaxed));
-            let sample = j % phase.sample_every == 0 || j == phase.steps || stopping;
+            // A stop request makes this step the last: checkpointed, and sampled like the
+            // last of the run.
+            let stopping = stop.is_some_and(|s| s.load(Ordering::Relaxed)) || opts.stop_after_step == Some(k);
+            let sample = j % phase.sample_every == 0 || j == phase.steps;
             let frame = phase.frame_every.is_some_and(|every| j % every == 0);
+            let checkpoint = (checkpointing.every.is_some_and(|n| k % n == 0) && k < total) || (stopping && outputs.folder.is_some());
             // Whether anything below looks at the grains after this step: else the step's
             // final half kick is left to the next one's drift.
-            let look = sample || frame || impact.is_some();
+            let look = sample || frame || checkpoint || stopping || st.impact.is_some();
             if let Err(err) = e.advance(look) {
                 error = Some(err);
                 break 'run;
             }
-            if let Some(o) = impact.as_mut() {
+            if let Some(o) = st.impact.as_mut() {
                 // The observer records every step (its curve is an output): every step's
                 // state is checked first, cheap for the one or two grains of an impact.
                 if let Err(err) = e.health() {
@@ -232,59 +413,64 @@ pub fn run_report(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<
                 }
                 o.observe(&e.view());
             }
-            walls_avg.accumulate(&e.view());
+            st.walls_avg.accumulate(&e.view());
             // Nothing is written of a state that failed its check: outputs hold only
             // finite numbers, and the stop is diagnosed in the summary.
-            if (sample || frame)
+            if (sample || frame || checkpoint || stopping)
                 && let Err(err) = e.health()
             {
                 error = Some(err);
                 break 'run;
             }
             if sample {
-                or_stop!('run, record_energy(e, &mut outputs, stage));
-                if let Some(row) = walls_avg.row(&e.view(), built.length, built.depth) {
-                    if let Some(w) = outputs.walls.as_mut() {
-                        or_stop!('run, w.row_in(stage, &row));
-                    }
-                    wall_rows.push(row);
-                }
+                or_stop!('run, st.sample(e, &mut outputs, stage, energy_on, length, depth));
             }
             if frame {
                 or_stop!('run, outputs.frame(e));
+            }
+            if j == phase.steps {
+                st.stage_ends.push(st.wall_rows.len());
+            }
+            // The state after this step and everything written of it, before a stop's
+            // own sample: the resumed run goes on as if the stop had not been.
+            if checkpoint {
+                let so_far = st.wall_time_s + t0.elapsed().as_secs_f64();
+                or_stop!('run, checkpointing.write(e, &mut outputs, &mut st, so_far));
             }
             if k % 1000 == 0
                 && let Some(b) = &bar
             {
                 b.set_position(k);
-                b.set_message(progress_message(&shown, e.time(), wall_rows.last()));
+                b.set_message(progress_message(&shown, e.time(), st.wall_rows.last()));
             }
             // Without a terminal, a line at each tenth of the run.
             if lines && k * 10 >= next_line * total {
                 next_line = k * 10 / total + 1;
                 let secs = t0.elapsed().as_secs_f64();
-                let eta = secs * (total - k) as f64 / k as f64;
-                let _ = writeln!(std::io::stderr().lock(), "{}: {}% of {} steps, {secs:.1} s, eta {eta:.1} s", progress_message(&shown, e.time(), wall_rows.last()), 100 * k / total, total);
+                let eta = secs * (total - k) as f64 / (k - k0) as f64;
+                let _ = writeln!(std::io::stderr().lock(), "{}: {}% of {} steps, {secs:.1} s, eta {eta:.1} s", progress_message(&shown, e.time(), st.wall_rows.last()), 100 * k / total, total);
             }
             if stopping {
+                if !sample {
+                    or_stop!('run, st.sample(e, &mut outputs, stage, energy_on, length, depth));
+                }
                 error = Some(Error::Interrupted { step: e.steps(), time: e.time() });
                 break 'run;
             }
-            if impact.as_ref().is_some_and(|o| o.finished()) {
+            if st.impact.as_ref().is_some_and(|o| o.finished()) {
                 match e.health() {
                     Err(err) => error = Some(err),
-                    Ok(()) => or_note!("energy.csv", record_energy(e, &mut outputs, stage)),
+                    Ok(()) => or_note!("energy.csv", st.record_energy(e, &mut outputs, stage, energy_on)),
                 }
                 break 'run;
             }
         }
-        stage_ends.push(wall_rows.len());
     }
-    // A stage cut short by a stop ends at the last row.
-    if stage_ends.len() < phases.len() {
-        stage_ends.push(wall_rows.len());
+    // A stage cut short ends at the last row.
+    if st.stage_ends.len() <= reached {
+        st.stage_ends.push(st.wall_rows.len());
     }
-    let wall_time = t0.elapsed().as_secs_f64();
+    let wall_time = st.wall_time_s + t0.elapsed().as_secs_f64();
     if let Some(b) = bar {
         b.finish_and_clear();
     }
@@ -294,9 +480,9 @@ pub fn run_report(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<
     let mut stages = Vec::new();
     let mut shear = None;
     let mut from = 0;
-    for (phase, &to) in phases.iter().zip(&stage_ends) {
-        let rows = &wall_rows[from..to];
-        let averaged = (scene.analysis == Analysis::Shear && phase.average && rows.len() >= 4).then(|| shear_summary(rows, e.particles(), built.length));
+    for (phase, &to) in phases.iter().zip(&st.stage_ends) {
+        let rows = &st.wall_rows[from..to];
+        let averaged = (scene.analysis == Analysis::Shear && phase.average && rows.len() >= 4).then(|| shear_summary(rows, e.particles(), length));
         if averaged.is_some() {
             shear.clone_from(&averaged);
         }
@@ -314,6 +500,7 @@ pub fn run_report(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<
         from = to;
     }
     let mut provenance = Provenance::new(started, e.threads(), &opts.command, opts.out.as_ref().map(|_| RESOLVED_SCENE.to_string()));
+    provenance.resumed_at_steps.clone_from(&st.resumed);
     provenance.end();
     let p = e.particles();
     let summary = Summary {
@@ -333,8 +520,8 @@ pub fn run_report(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<
         simulated_time_s: e.time(),
         wall_time_s: wall_time,
         particle_steps_per_s: p.n_free as f64 * e.steps() as f64 / wall_time.max(1e-9),
-        energy: energy_on.then(|| energy_summary(last_row.unwrap_or_else(|| e.energy_row()), max_res, dt)),
-        impact: impact.as_ref().and_then(|o| o.summary()),
+        energy: energy_on.then(|| energy_summary(st.last_row.unwrap_or_else(|| e.energy_row()), st.max_res, dt)),
+        impact: st.impact.as_ref().and_then(|o| o.summary()),
         shear,
         stages,
         stage_timing,
@@ -356,8 +543,12 @@ pub fn run_report(scene: &Scene, mut built: Built, opts: &RunOptions) -> Result<
                 or_note!(name, folder.close_series(s, name));
             }
         }
-        if let Some(o) = impact.as_ref() {
+        if let Some(o) = st.impact.as_ref() {
             or_note!("force_overlap.csv", folder.write_series("force_overlap.csv", &o.curve));
+        }
+        // A completed run has nothing to resume: its checkpoint goes.
+        if error.is_none() {
+            or_note!(CHECKPOINT, folder.remove(CHECKPOINT));
         }
         or_note!("summary.json", folder.write("summary.json", (serde_json::to_string_pretty(&summary).expect("serialisable") + "\n").as_bytes()));
         or_note!("manifest.json", folder.finish(&summary.status));

@@ -158,7 +158,7 @@ pub struct ContactHistory<H> {
 /// values of the terms it integrates by the trapezoid rule, and the contact's sums of
 /// the ledger's terms since they were last taken ([`crate::physics::energy`]).
 /// (`R = Lanes`: of four contacts.)
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Copy, Debug, Default, Serialize, Deserialize)]
 pub struct EnergyMemory<R: Real = f64> {
     /// Previous normal damping force (for the trapezoidal energy integrals), N.
     pub fd_prev: R,

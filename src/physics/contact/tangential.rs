@@ -47,6 +47,11 @@ pub trait Tangential: Copy + Default + Send + Sync + 'static {
     const FRICTION: bool;
     /// The state a contact carries from step to step (one per lane with `R = Lanes`).
     type History<R: Real>: Copy + Default + Send + Sync + std::fmt::Debug;
+    /// A contact's state as a checkpoint stores it, the same numbers as its
+    /// `History<f64>` ([`crate::engine::snapshot`]).
+    type Saved: serde::Serialize + serde::de::DeserializeOwned;
+    fn save(h: Self::History<f64>) -> Self::Saved;
+    fn load(s: Self::Saved) -> Self::History<f64>;
     fn force<R: Real>(h: &mut Self::History<R>, inp: &TangentialInput<R>) -> TangentialForce<R>;
     /// Four contacts' states in lanes.
     fn gather(h: [&Self::History<f64>; crate::physics::lanes::LANES]) -> Self::History<crate::physics::lanes::Lanes>;
@@ -62,6 +67,9 @@ impl Tangential for Frictionless {
     const NAME: &'static str = "Frictionless";
     const FRICTION: bool = false;
     type History<R: Real> = ();
+    type Saved = ();
+    fn save(_: ()) {}
+    fn load(_: ()) {}
     #[inline(always)]
     fn force<R: Real>(_: &mut (), _: &TangentialInput<R>) -> TangentialForce<R> {
         TangentialForce::default()
@@ -84,6 +92,13 @@ impl Tangential for TotalDisplacement {
     const FRICTION: bool = true;
     /// The tangential displacement xi, m.
     type History<R: Real> = Vector2<R>;
+    type Saved = Vector2<f64>;
+    fn save(xi: Vector2<f64>) -> Vector2<f64> {
+        xi
+    }
+    fn load(xi: Vector2<f64>) -> Vector2<f64> {
+        xi
+    }
     #[inline(always)]
     fn force<R: Real>(xi: &mut Vector2<R>, inp: &TangentialInput<R>) -> TangentialForce<R> {
         let n = inp.n;
@@ -115,7 +130,7 @@ impl Tangential for TotalDisplacement {
 }
 
 /// State of a YADE-style incremental contact.
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Copy, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct IncrementalState<R: Real = f64> {
     /// Elastic tangential force on grain i, N.
     pub force: Vector2<R>,
@@ -134,6 +149,13 @@ impl Tangential for IncrementalForce {
     const NAME: &'static str = "IncrementalForce";
     const FRICTION: bool = true;
     type History<R: Real> = IncrementalState<R>;
+    type Saved = IncrementalState<f64>;
+    fn save(h: IncrementalState<f64>) -> IncrementalState<f64> {
+        h
+    }
+    fn load(h: IncrementalState<f64>) -> IncrementalState<f64> {
+        h
+    }
     #[inline(always)]
     fn force<R: Real>(h: &mut IncrementalState<R>, inp: &TangentialInput<R>) -> TangentialForce<R> {
         let n = inp.n;
