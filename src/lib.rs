@@ -36,6 +36,8 @@
 //!    the skin ([`engine::neighbor`]), where the domain's checks stop a run that goes
 //!    wrong with a diagnosis ([`engine::domain`]). With the `parallel` feature the
 //!    contact forces run on several threads, bit for bit as on one (`engine::parallel`).
+//!    Everything a simulation carries from step to step can be saved and restored into
+//!    one built from the same scene, for an exact restart ([`engine::snapshot`]).
 //! 5. **Observers** ([`observe`]): impacts ([`observe::impact`]), wall stresses
 //!    ([`observe::stress`]), the energy balance's summary ([`observe::energy`]),
 //!    block-averaged confidence intervals ([`observe::stats`]), each from a [`View`].
@@ -43,9 +45,11 @@
 //!    empty or `null`): `summary.json` ([`output::summary`]), CSV time series with
 //!    unit-suffixed headers, ParaView `.vtp` frames with a `.pvd` index, in an output
 //!    folder that is grainlab's ([`output::folder`]: a manifest, files that appear whole),
-//!    with the scene as it ran and what produced the run ([`output::provenance`]).
+//!    with the scene as it ran and what produced the run ([`output::provenance`]), and
+//!    the checkpoint a run resumes from ([`output::checkpoint`]: versioned, checksummed).
 //! 7. **Studies** ([`study`]): a run with its progress bar, observers and outputs, ended
-//!    early on a stop request with everything written ([`study::run`]); sweeps over time
+//!    early on a stop request with everything written, checkpointed and resumed bit for
+//!    bit ([`study::run`], [`study::protocol`]: a scene's stages as phases of the run); sweeps over time
 //!    steps and model variants ([`study::sweep`]); the accuracy calibration that picks a
 //!    time step for a stated accuracy before the engine is built ([`study::accuracy`]).
 //! 8. **Workbench** ([`workbench`]): the reference cases under `reference/`
