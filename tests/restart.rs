@@ -249,6 +249,19 @@ fn damaged_foreign_and_other_builds_checkpoints_are_refused() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("is missing"));
 }
 
+/// `--checkpoint-every` needs a folder to write in and a rate above 0: refused before the
+/// build, exit code 2.
+#[test]
+fn checkpoints_need_an_output_folder_and_a_rate() {
+    let out = grainlab_cmd().args(["run", "collision", "--quiet", "--checkpoint-every", "1e-6"]).output().unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--checkpoint-every = 0.000001; allowed: with an output folder"), "{}", String::from_utf8_lossy(&out.stderr));
+    let tmp = tempfile::tempdir().unwrap();
+    let out = grainlab_cmd().args(["run", "collision", "--quiet", "--checkpoint-every=0", "--out"]).arg(tmp.path().join("o")).output().unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(!tmp.path().join("o").exists(), "nothing written");
+}
+
 /// The command line, killed: `grainlab run --checkpoint-every` killed with SIGKILL (no
 /// chance to write anything more) after its first checkpoints, then `grainlab resume`,
 /// gives the bytes of the run that was never killed.
