@@ -372,7 +372,7 @@ fn execute(cli: Cli) -> Result<(), Error> {
                 note!("seed {}: {}; {ratio}; {:.1} s", r.seed, r.status, r.wall_time_s);
             })?;
             if let Some(x) = &e.stress_ratio {
-                let spread = x.spread_over_block_ci.map(|q| format!("; run-to-run spread {q:.2}x the mean block half-width")).unwrap_or_default();
+                let spread = x.spread_over_standard_error.map(|q| format!("; run-to-run spread {q:.2}x the runs' mean block standard error (about 1 if their intervals hold)")).unwrap_or_default();
                 note!("{}: tau/sigma = {:.4} +- {:.4} (95%, from the spread of {} runs: std {:.4}){spread}", e.scene, x.mean, x.ci95, x.runs, x.std);
             }
             let text = serde_json::to_string_pretty(&e).expect("serialisable") + "\n";

@@ -360,7 +360,8 @@ fn a_run_reports_progress_lines_and_a_headline() {
     assert_eq!(progress.len(), 10, "{err}");
     assert!(progress.last().unwrap().contains("100% of"), "{err}");
     let headline = err.lines().find(|l| l.starts_with("shear: completed; tau/sigma = ")).unwrap_or_else(|| panic!("{err}"));
-    assert!(headline.contains("(95%, 10 blocks)") && headline.contains("sigma = ") && headline.contains("energy residual"), "{headline}");
+    let blocks = headline.split("(95%, ").nth(1).and_then(|s| s.split(" blocks)").next()).and_then(|n| n.parse::<usize>().ok());
+    assert!(blocks.is_some_and(|b| (2..=100).contains(&b)) && headline.contains("sigma = ") && headline.contains("energy residual"), "{headline}");
     // --quiet: no progress, the headline still.
     let out = grainlab().args(["run", "shear", "--duration", "2e-4", "--quiet"]).output().unwrap();
     let err = String::from_utf8_lossy(&out.stderr);

@@ -7,7 +7,7 @@ use grainlab::study::ensemble::{ensemble, parse_seeds};
 
 #[test]
 fn three_seeds_give_three_packings_and_the_t_interval_of_their_spread() {
-    // 300 grains over 1.5 ms: short runs, but each has its 10 blocks of tau/sigma.
+    // 300 grains over 1.5 ms: short runs, each with its blocks of tau/sigma.
     let scene = shear_cell(300, 0.012);
     let mut heard = Vec::new();
     let e = ensemble(&scene, &[1, 2, 3], Some(1.5e-3), 1, &Limits::machine(), |r| heard.push(r.seed)).unwrap();
@@ -27,7 +27,16 @@ fn three_seeds_give_three_packings_and_the_t_interval_of_their_spread() {
     approx::assert_relative_eq!(s.ci95, 4.303 * std / 3f64.sqrt(), max_relative = 1e-3);
     let blocks = e.runs.iter().map(|r| r.stress_ratio.unwrap().ci95).sum::<f64>() / 3.0;
     approx::assert_relative_eq!(s.mean_block_ci95.unwrap(), blocks, max_relative = 1e-12);
-    approx::assert_relative_eq!(s.spread_over_block_ci.unwrap(), std / blocks, max_relative = 1e-12);
+    // A run's standard error is its half-width over t(0.975, blocks - 1); t from
+    // statrs, checked against the table where the blocks allow (2 blocks: 12.706).
+    let se = |r: &grainlab::study::ensemble::EnsembleRun| {
+        let x = r.stress_ratio.unwrap();
+        x.ci95 / statrs::distribution::ContinuousCDF::inverse_cdf(&statrs::distribution::StudentsT::new(0.0, 1.0, (x.blocks - 1) as f64).unwrap(), 0.975)
+    };
+    let mean_se = e.runs.iter().map(se).sum::<f64>() / 3.0;
+    approx::assert_relative_eq!(s.mean_block_standard_error.unwrap(), mean_se, max_relative = 1e-12);
+    approx::assert_relative_eq!(s.spread_over_standard_error.unwrap(), std / mean_se, max_relative = 1e-12);
+    approx::assert_relative_eq!(statrs::distribution::ContinuousCDF::inverse_cdf(&statrs::distribution::StudentsT::new(0.0, 1.0, 1.0).unwrap(), 0.975), 12.706, max_relative = 1e-4);
     // The top wall carries the confining load (100 kPa): the ensemble's mean normal
     // stress is that within its own 95% interval (wide for so small and short a cell).
     let sigma = e.normal_stress_pa.as_ref().unwrap();

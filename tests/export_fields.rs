@@ -40,6 +40,9 @@ enum Kind {
     Choice(Vec<String>),
     /// A fixed-length array of numbers (a vector), changed one element at a time.
     Numbers,
+    /// One of several kinds (an untagged enum, `"auto"` or a number): a change may move
+    /// to any of them.
+    Either(Vec<Kind>),
 }
 
 fn resolve<'a>(root: &'a Value, node: &'a Value) -> &'a Value {
@@ -71,8 +74,20 @@ fn is_object(root: &Value, node: &Value) -> bool {
 fn leaves(root: &Value, node: &Value, path: &str, out: &mut BTreeMap<String, Kind>) {
     let node = resolve(root, node);
     if let Some(any) = node.get("anyOf").and_then(Value::as_array) {
-        for alt in any.iter().filter(|a| a.get("type") != Some(&json!("null"))) {
-            leaves(root, alt, path, out);
+        let alts: Vec<&Value> = any.iter().filter(|a| a.get("type") != Some(&json!("null"))).collect();
+        let mut kinds = Vec::new();
+        for alt in &alts {
+            let mut one = BTreeMap::new();
+            leaves(root, alt, path, &mut one);
+            // An alternative that is a leaf itself joins the others; its fields below (an
+            // enum's variants with data) are leaves of their own.
+            kinds.extend(one.remove(path));
+            out.extend(one);
+        }
+        match kinds.len() {
+            0 => {}
+            1 => drop(out.insert(path.to_string(), kinds.pop().unwrap())),
+            _ => drop(out.insert(path.to_string(), Kind::Either(kinds))),
         }
         return;
     }
@@ -159,8 +174,17 @@ fn present(root: &Value, node: &Value, value: &Value, path: &str, pointer: &str,
     }
     let node = resolve(root, node);
     if let Some(any) = node.get("anyOf").and_then(Value::as_array) {
-        let alt = any.iter().find(|a| a.get("type") != Some(&json!("null"))).unwrap();
-        return present(root, alt, value, path, pointer, out);
+        let alts: Vec<&Value> = any.iter().filter(|a| a.get("type") != Some(&json!("null"))).collect();
+        if alts.len() > 1 {
+            // An untagged enum of leaves: the leaf with every alternative's kind.
+            let mut one = BTreeMap::new();
+            leaves(root, node, path, &mut one);
+            if let Some(kind) = one.remove(path) {
+                out.push(Present { path: path.to_string(), pointer: pointer.to_string(), kind });
+                return;
+            }
+        }
+        return present(root, alts[0], value, path, pointer, out);
     }
     if let Some(one) = node.get("oneOf").and_then(Value::as_array) {
         match value {
@@ -207,7 +231,23 @@ fn number_candidates(v: f64) -> Vec<f64> {
 
 /// Candidate values for the leaf at `at` (each a whole new value of the leaf).
 fn candidates(at: &Present, v: &Value) -> Vec<Vec<Value>> {
-    match &at.kind {
+    candidates_of(&at.kind, v)
+}
+
+fn candidates_of(kind: &Kind, v: &Value) -> Vec<Vec<Value>> {
+    match kind {
+        // Each alternative's changes from this value, or (another alternative) its values.
+        Kind::Either(kinds) => kinds
+            .iter()
+            .flat_map(|k| match k {
+                Kind::Integer if !v.is_u64() => vec![vec![json!(10)]],
+                Kind::Number if !v.is_number() => vec![vec![json!(1.0)]],
+                Kind::Choice(units) if !v.is_string() => units.iter().map(|u| vec![json!(u)]).collect(),
+                Kind::Integer | Kind::Number if !v.is_number() => Vec::new(),
+                Kind::Choice(_) if !v.is_string() => Vec::new(),
+                k => candidates_of(k, v),
+            })
+            .collect(),
         Kind::Number => vec![number_candidates(v.as_f64().unwrap()).into_iter().map(|x| json!(x)).collect()],
         Kind::Integer => {
             let n = v.as_u64().unwrap();

@@ -24,7 +24,7 @@ fn energy_balance_closes_in_a_short_shear_run() {
 fn the_loaded_wall_carries_the_requested_stress() {
     // Averaged over the second half of a short run, the normal stress the grains exert on
     // the walls equals the applied pressure within its 95% interval plus 10% (the wall is
-    // still settling; the interval is from 10 blocks).
+    // still settling; the interval's blocks are cut from the measured autocorrelation).
     let mut s = shear();
     s.duration = 4e-3;
     s.output.frames = 0;

@@ -168,7 +168,8 @@ fn oblique_table_snapshot() {
 #[test]
 fn shear_cell_stresses_agree_with_liggghts_and_yade_within_the_combined_interval() {
     // Chaotic dynamics: only time averages can agree. tau, sigma and tau/sigma over the
-    // second half of the run (10 blocks each) must differ by less than the combined 95%
+    // second half of the run (blocks from each series' autocorrelation time, the same rule
+    // for both sides: the digest applies the scene's statistics) must differ by less than the combined 95%
     // interval sqrt(ci_engine^2 + ci_reference^2), and Welch's t test on tau/sigma must not
     // reject equal means at 5%. Each code runs its own formulation
     // (shear/liggghts: total displacement; shear/yade: incremental force, YADE's

@@ -11,7 +11,8 @@
 use serde::{Deserialize, Serialize};
 
 use crate::engine::world::View;
-use crate::observe::stats::{Estimate, block_average};
+use crate::observe::stats::{Blocking, Estimate, estimate};
+use crate::scene::StatisticsSpec;
 use crate::physics::dim::Vec2;
 
 /// One row of the wall time series (forces averaged over the sample interval).
@@ -87,7 +88,7 @@ impl WallRow {
 /// The time averages of a shear run's wall stresses.
 #[derive(Clone, Debug, Serialize, serde::Deserialize)]
 pub struct ShearSummary {
-    /// Time from which averages are taken (second half of the run), s.
+    /// Time from which averages are taken (`statistics.average_from` of the stretch), s.
     pub averaged_from_s: f64,
     pub shear_stress_pa: Estimate,
     pub normal_stress_pa: Estimate,
@@ -99,19 +100,24 @@ pub struct ShearSummary {
     pub packing_fraction: Option<f64>,
 }
 
-/// Time averages of the wall stresses over the second half of a wall series, in 10
-/// blocks (the same estimator for the engine and for the reference codes' output).
-pub fn stress_estimates(rows: &[WallRow], packing_fraction: Option<f64>) -> ShearSummary {
-    let half = &rows[rows.len() / 2..];
-    let col = |f: fn(&WallRow) -> f64| half.iter().map(f).collect::<Vec<f64>>();
-    let blocks = 10.min(half.len());
+/// Time averages of the wall stresses of a stretch of wall rows (a run, or an averaged
+/// stage) from `statistics.average_from` of its rows on, each quantity's 95% interval
+/// from blocks as `statistics.blocks` says (the same estimator for the engine and for
+/// the reference codes' output). The rows must be at least 4.
+pub fn stress_estimates(rows: &[WallRow], packing_fraction: Option<f64>, statistics: &StatisticsSpec) -> ShearSummary {
+    let from = ((rows.len() as f64 * statistics.average_from) as usize).min(rows.len().saturating_sub(4));
+    let kept = &rows[from..];
+    let col = |f: fn(&WallRow) -> f64| kept.iter().map(f).collect::<Vec<f64>>();
+    // The rows of a stretch are evenly spaced (a stage's rate is its own).
+    let interval = if kept.len() >= 2 { (kept[kept.len() - 1].time_s - kept[0].time_s) / (kept.len() - 1) as f64 } else { 0.0 };
+    let blocking = Blocking::from(statistics.blocks);
     ShearSummary {
-        averaged_from_s: half[0].time_s,
-        shear_stress_pa: block_average(&col(|r| r.shear_stress_pa), blocks),
-        normal_stress_pa: block_average(&col(|r| r.normal_stress_pa), blocks),
+        averaged_from_s: kept[0].time_s,
+        shear_stress_pa: estimate(&col(|r| r.shear_stress_pa), blocking, interval),
+        normal_stress_pa: estimate(&col(|r| r.normal_stress_pa), blocking, interval),
         stress_ratio: {
-            let defined: Vec<f64> = half.iter().filter_map(|r| r.stress_ratio).collect();
-            (defined.len() >= 2).then(|| block_average(&defined, 10.min(defined.len())))
+            let defined: Vec<f64> = kept.iter().filter_map(|r| r.stress_ratio).collect();
+            (defined.len() >= 4).then(|| estimate(&defined, blocking, interval))
         },
         packing_fraction,
     }

@@ -51,6 +51,7 @@ pub fn head_on(material: Material, r: f64, v: f64, steps_per_contact: f64) -> Sc
         neighbor: NeighborSpec::default(),
         output: OutputSpec { samples: 200, frames: 0, energy: true },
         analysis: Analysis::Impact,
+        statistics: Default::default(),
         stages: Vec::new(),
     }
 }
@@ -126,6 +127,7 @@ pub fn shear() -> Scene {
         neighbor: NeighborSpec::default(),
         output: OutputSpec { samples: 400, frames: 20, energy: true },
         analysis: Analysis::Shear,
+        statistics: Default::default(),
         stages: Vec::new(),
     }
 }

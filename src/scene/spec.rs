@@ -50,6 +50,10 @@ pub struct Scene {
     /// What the summary reports. Default: none.
     #[serde(default)]
     pub analysis: Analysis,
+    /// How a shear analysis averages its rows: from where, in how many blocks. Default:
+    /// the second half of each averaged stretch, blocks from the measured autocorrelation.
+    #[serde(default)]
+    pub statistics: StatisticsSpec,
     /// A protocol: stages run one after another, each changing the walls' motion and
     /// control, gravity, the output rates and the averaging at its start. Default: none
     /// (the scene runs as given for `duration`).
@@ -416,6 +420,55 @@ impl Default for OutputSpec {
     }
 }
 
+/// How a shear analysis averages the wall rows of a run, or of each averaged stage
+/// (docs/statistics.md).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct StatisticsSpec {
+    /// Where the average starts, as a fraction of the stretch's rows (the run's, or the
+    /// averaged stage's): the rows before it are the transient left out. 0 <= f < 1;
+    /// default 0.5 (the second half).
+    #[serde(default = "default_average_from")]
+    pub average_from: f64,
+    /// Blocks of the 95% interval of each quantity: `"auto"` (default) cuts the averaged
+    /// rows into blocks of 8 integrated autocorrelation times of that quantity, measured
+    /// on its rows (at least 2 blocks, at most 100; the time is reported); a number from 2
+    /// to 1000 fixes the count.
+    #[serde(default)]
+    pub blocks: BlocksSpec,
+}
+
+fn default_average_from() -> f64 {
+    0.5
+}
+
+impl Default for StatisticsSpec {
+    fn default() -> Self {
+        StatisticsSpec { average_from: default_average_from(), blocks: BlocksSpec::default() }
+    }
+}
+
+/// `"auto"` or a number of blocks ([`StatisticsSpec::blocks`]).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(untagged)]
+pub enum BlocksSpec {
+    Auto(AutoBlocks),
+    Count(u64),
+}
+
+/// The word `"auto"`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum AutoBlocks {
+    Auto,
+}
+
+impl Default for BlocksSpec {
+    fn default() -> Self {
+        BlocksSpec::Auto(AutoBlocks::Auto)
+    }
+}
+
 /// What the summary reports.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
@@ -424,7 +477,7 @@ pub enum Analysis {
     None,
     /// Grain 0 against grain 1, or grain 0 against a wall: restitution, overlap, force.
     Impact,
-    /// Wall stresses with confidence intervals over the second half of the run.
+    /// Wall stresses with confidence intervals, averaged as `statistics` says.
     Shear,
 }
 

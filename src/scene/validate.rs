@@ -162,6 +162,11 @@ impl Scene {
         check(finite_pos(self.duration), "", "duration", self.duration, if self.stages.is_empty() { "> 0 s (required without stages)" } else { "> 0 s" })?;
         check(finite_pos(self.neighbor.skin) && self.neighbor.skin <= 2.0, "neighbor", "skin", self.neighbor.skin, "(0, 2] smallest diameters")?;
         check(self.output.samples >= 1, "output", "samples", self.output.samples, ">= 1")?;
+        let st = &self.statistics;
+        check((0.0..1.0).contains(&st.average_from), "statistics", "average_from", st.average_from, "a fraction of the averaged rows, 0 <= f < 1")?;
+        if let crate::scene::BlocksSpec::Count(k) = st.blocks {
+            check((2..=1000).contains(&k), "statistics", "blocks", k, "\"auto\", or 2 to 1000 blocks")?;
+        }
         check(self.output.frames <= MAX_FRAMES, "output", "frames", self.output.frames, &format!("0 to {MAX_FRAMES} (each frame rewrites the .pvd index and the manifest)"))?;
         if self.analysis == Analysis::Shear {
             check(self.walls.is_some() && self.domain.periodic_x.is_some(), "", "analysis", "shear", "a scene with walls and periodic_x")?;

@@ -1,7 +1,7 @@
 //! An ensemble: one shear scene run over several packing seeds, independent realisations
 //! of the same packing statistics (`grainlab ensemble`). Each quantity's ensemble mean
 //! gets a 95% interval from the run-to-run spread (Student t over the runs), beside each
-//! run's own block interval ([`crate::observe::stats::block_average`]): a sheared
+//! run's own block interval ([`crate::observe::stats::estimate`]): a sheared
 //! packing is chaotic, and a run's block interval does not cover what another seed gives.
 
 use serde::Serialize;
@@ -47,11 +47,14 @@ pub struct EnsembleStat {
     /// The runs' own block intervals (95% half-widths), averaged; none for a quantity
     /// without one (the packing fraction).
     pub mean_block_ci95: Option<f64>,
-    /// Run-to-run standard deviation over the mean block half-width. Were the block
-    /// intervals honest, a run's mean would scatter by one standard error, and a 10-block
-    /// half-width is t(0.975, 9) = 2.26 standard errors: about 0.45. Above it, the runs
+    /// The runs' own standard errors of the mean, averaged: each run's block half-width
+    /// over its t(0.975, blocks - 1).
+    pub mean_block_standard_error: Option<f64>,
+    /// Run-to-run standard deviation over the mean block standard error. Were the block
+    /// intervals honest, a run's mean would scatter from run to run by its standard
+    /// error: about 1 (with 8 runs, itself uncertain by about a quarter). Above, the runs
     /// scatter more than their block intervals allow.
-    pub spread_over_block_ci: Option<f64>,
+    pub spread_over_standard_error: Option<f64>,
 }
 
 /// An ensemble's runs and statistics (`ensemble.json`).
@@ -125,7 +128,7 @@ pub fn ensemble(scene: &Scene, seeds: &[u64], duration: Option<f64>, threads: us
         runs.push(run);
     }
     let done: Vec<&EnsembleRun> = runs.iter().filter(|r| r.status == "completed").collect();
-    let of = |f: &dyn Fn(&EnsembleRun) -> Option<Estimate>| stat(&done.iter().filter_map(|r| f(r)).map(|e| (e.mean, Some(e.ci95))).collect::<Vec<_>>());
+    let of = |f: &dyn Fn(&EnsembleRun) -> Option<Estimate>| stat(&done.iter().filter_map(|r| f(r)).map(|e| (e.mean, Some((e.ci95, e.blocks)))).collect::<Vec<_>>());
     Ok(Ensemble {
         scene: scene.name.clone(),
         seeds: seeds.to_vec(),
@@ -137,24 +140,31 @@ pub fn ensemble(scene: &Scene, seeds: &[u64], duration: Option<f64>, threads: us
     })
 }
 
-/// The ensemble statistics of the runs' values (each with its block half-width, if any);
-/// none for fewer than two values or a value that is not finite.
-fn stat(values: &[(f64, Option<f64>)]) -> Option<EnsembleStat> {
+/// t(0.975, dof), Student's t's 97.5% quantile.
+fn t975(dof: usize) -> f64 {
+    StudentsT::new(0.0, 1.0, dof.max(1) as f64).expect("dof >= 1").inverse_cdf(0.975)
+}
+
+/// The ensemble statistics of the runs' values (each with its block half-width and block
+/// count, if any); none for fewer than two values or a value that is not finite.
+fn stat(values: &[(f64, Option<(f64, usize)>)]) -> Option<EnsembleStat> {
     let n = values.len();
-    if n < 2 || values.iter().any(|(x, c)| !x.is_finite() || c.is_some_and(|c| !c.is_finite())) {
+    if n < 2 || values.iter().any(|(x, c)| !x.is_finite() || c.is_some_and(|c| !c.0.is_finite())) {
         return None;
     }
     let mean = values.iter().map(|v| v.0).sum::<f64>() / n as f64;
     let std = (values.iter().map(|v| (v.0 - mean).powi(2)).sum::<f64>() / (n - 1) as f64).sqrt();
-    let t = StudentsT::new(0.0, 1.0, (n - 1) as f64).expect("dof >= 1").inverse_cdf(0.975);
-    let blocks: Vec<f64> = values.iter().filter_map(|v| v.1).collect();
-    let mean_block_ci95 = (blocks.len() == n).then(|| blocks.iter().sum::<f64>() / n as f64);
+    let blocks: Vec<(f64, usize)> = values.iter().filter_map(|v| v.1).collect();
+    let all = blocks.len() == n;
+    let mean_block_ci95 = all.then(|| blocks.iter().map(|b| b.0).sum::<f64>() / n as f64);
+    let mean_block_standard_error = all.then(|| blocks.iter().map(|&(c, k)| c / t975(k.saturating_sub(1))).sum::<f64>() / n as f64);
     Some(EnsembleStat {
         runs: n,
         mean,
         std,
-        ci95: t * std / (n as f64).sqrt(),
+        ci95: t975(n - 1) * std / (n as f64).sqrt(),
         mean_block_ci95,
-        spread_over_block_ci: mean_block_ci95.filter(|&c| c > 0.0).map(|c| std / c),
+        mean_block_standard_error,
+        spread_over_standard_error: mean_block_standard_error.filter(|&c| c > 0.0).map(|c| std / c),
     })
 }

@@ -482,7 +482,7 @@ fn drive(scene: &Scene, mut built: Built, opts: &RunOptions, resumed: Option<(Ou
     let mut from = 0;
     for (phase, &to) in phases.iter().zip(&st.stage_ends) {
         let rows = &st.wall_rows[from..to];
-        let averaged = (scene.analysis == Analysis::Shear && phase.average && rows.len() >= 4).then(|| shear_summary(rows, e.particles(), length));
+        let averaged = (scene.analysis == Analysis::Shear && phase.average && rows.len() >= 4).then(|| shear_summary(rows, e.particles(), length, &scene.statistics));
         if averaged.is_some() {
             shear.clone_from(&averaged);
         }
@@ -565,9 +565,9 @@ fn progress_message(name: &str, time: f64, row: Option<&WallRow>) -> String {
 
 /// The shear estimates of a run's wall rows, and the packing fraction at the last row (its
 /// gap: of a state that passed its checks, also when the run stopped after it).
-fn shear_summary(rows: &[WallRow], p: &crate::physics::particles::Particles, length: f64) -> ShearSummary {
+fn shear_summary(rows: &[WallRow], p: &crate::physics::particles::Particles, length: f64, statistics: &crate::scene::StatisticsSpec) -> ShearSummary {
     let area: f64 = (0..p.n_free).map(|i| std::f64::consts::PI * p.r[i] * p.r[i]).sum();
     let gap = rows.last().map_or(f64::NAN, |r| r.gap_m);
-    stress_estimates(rows, Some(area / (length * gap)).filter(|f| f.is_finite()))
+    stress_estimates(rows, Some(area / (length * gap)).filter(|f| f.is_finite()), statistics)
 }
 

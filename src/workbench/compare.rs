@@ -113,7 +113,7 @@ pub fn compare_impact(case: &str, code: Code, engine: &ImpactSummary, reference:
 /// interval `sqrt(ci_a^2 + ci_b^2)` (a Welch-type bound on two independent estimates).
 pub fn compare_shear(case: &str, code: Code, engine: &ShearSummary, reference: &ShearSummary) -> Vec<Row> {
     // tau/sigma is undefined without a normal stress: then it cannot agree.
-    let undefined = crate::observe::stats::Estimate { mean: f64::NAN, ci95: f64::NAN, blocks: 0 };
+    let undefined = crate::observe::stats::Estimate { mean: f64::NAN, ci95: f64::NAN, blocks: 0, autocorrelation_time_s: None };
     let (ratio_a, ratio_b) = (engine.stress_ratio.unwrap_or(undefined), reference.stress_ratio.unwrap_or(undefined));
     let pairs = [
         ("shear_stress_pa", engine.shear_stress_pa, reference.shear_stress_pa),

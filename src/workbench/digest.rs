@@ -70,7 +70,7 @@ pub fn digest(case_dir: &Path, code: Code, run_dir: &Path) -> Result<PathBuf, Er
             if averaged.len() < 4 {
                 return Err(Error::Other(format!("{}: fewer than 4 rows in the averaged stage", run_dir.join("walls.txt").display())));
             }
-            std::fs::write(out.join("shear.json"), serde_json::to_string_pretty(&stress_estimates(&averaged, None)).expect("serialisable") + "\n")
+            std::fs::write(out.join("shear.json"), serde_json::to_string_pretty(&stress_estimates(&averaged, None, &info.statistics)).expect("serialisable") + "\n")
                 .map_err(|e| Error::io(out.display(), e))?;
         }
         Analysis::None => return Err(Error::Other("export.json: analysis none".into())),

@@ -59,6 +59,9 @@ pub struct ExportInfo {
     /// step, so each row falls in one stage.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub stages: Vec<ExportStage>,
+    /// How the digest averages the rows (the scene's `statistics`, as grainlab's summary).
+    #[serde(default)]
+    pub statistics: crate::scene::StatisticsSpec,
 }
 
 /// One stage of an exported protocol ([`ExportInfo::stages`]).

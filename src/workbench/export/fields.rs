@@ -347,6 +347,8 @@ pub const FIELDS: &[Field] = &[
     ),
     both("stages[].frames", outside(NOT_PHYSICS_OUTPUT)),
     both("stages[].average", written("export.json stages[].average: the digest averages the last averaged stage's rows, as grainlab's summary")),
+    both("statistics.average_from", written("export.json statistics: the digest averages the code's rows from the same fraction on, as grainlab's summary")),
+    both("statistics.blocks", written("export.json statistics: the digest cuts the code's rows into blocks by the same rule, as grainlab's summary")),
 ];
 
 const STAGES_FLAT: &str = "a protocol with a flat wall: a flat wall's motion and contact histories live in the deck's wall fix or body, not checked across a stage change (refused as stages[0].duration)";

@@ -87,6 +87,7 @@ pub(crate) fn prepare(scene: &Scene, code: Code, limits: &crate::scene::limits::
         depth_m: built.depth,
         columns,
         stages: phases.iter().filter(|p| !p.name.is_empty()).map(|p| ExportStage { name: p.name.clone(), first_step: p.first, steps: p.steps, average: p.average }).collect(),
+        statistics: scene.statistics,
     };
     Ok(Exported { built, info, bench: false })
 }
