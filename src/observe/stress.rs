@@ -11,7 +11,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::engine::world::View;
-use crate::observe::stats::{Blocking, Estimate, estimate};
+use crate::observe::stats::{BLOCK_TAUS, Blocking, Estimate, estimate};
 use crate::scene::StatisticsSpec;
 use crate::physics::dim::Vec2;
 
@@ -98,6 +98,11 @@ pub struct ShearSummary {
     /// 2D packing fraction at the end (free grains' disk area over the gap area); not
     /// known for a reference code's wall output.
     pub packing_fraction: Option<f64>,
+    /// Why an interval is less than it says: the averaged rows too short for two
+    /// automatic blocks of a quantity (its interval then comes from 2 blocks shorter than
+    /// 8 autocorrelation times: wide, and still maybe too narrow). None when all hold.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub warning: Option<String>,
 }
 
 /// Time averages of the wall stresses of a stretch of wall rows (a run, or an averaged
@@ -111,14 +116,61 @@ pub fn stress_estimates(rows: &[WallRow], packing_fraction: Option<f64>, statist
     // The rows of a stretch are evenly spaced (a stage's rate is its own).
     let interval = if kept.len() >= 2 { (kept[kept.len() - 1].time_s - kept[0].time_s) / (kept.len() - 1) as f64 } else { 0.0 };
     let blocking = Blocking::from(statistics.blocks);
-    ShearSummary {
-        averaged_from_s: kept[0].time_s,
-        shear_stress_pa: estimate(&col(|r| r.shear_stress_pa), blocking, interval),
-        normal_stress_pa: estimate(&col(|r| r.normal_stress_pa), blocking, interval),
-        stress_ratio: {
-            let defined: Vec<f64> = kept.iter().filter_map(|r| r.stress_ratio).collect();
-            (defined.len() >= 4).then(|| estimate(&defined, blocking, interval))
-        },
-        packing_fraction,
+    let shear_stress_pa = estimate(&col(|r| r.shear_stress_pa), blocking, interval);
+    let normal_stress_pa = estimate(&col(|r| r.normal_stress_pa), blocking, interval);
+    let stress_ratio = {
+        let defined: Vec<f64> = kept.iter().filter_map(|r| r.stress_ratio).collect();
+        (defined.len() >= 4).then(|| estimate(&defined, blocking, interval))
+    };
+    // With automatic blocks: a quantity whose rows hold fewer than two blocks of
+    // BLOCK_TAUS autocorrelation times (or whose time is not known) is named.
+    let span = kept.len() as f64 * interval;
+    let short = |e: &Estimate| blocking == Blocking::Auto && e.autocorrelation_time_s.is_none_or(|t| 2.0 * BLOCK_TAUS * t > span);
+    let named: Vec<String> = [("shear stress", Some(&shear_stress_pa)), ("normal stress", Some(&normal_stress_pa)), ("tau/sigma", stress_ratio.as_ref())]
+        .into_iter()
+        .filter_map(|(name, e)| e.filter(|e| short(e)).map(|e| format!("{name} (autocorrelation time {})", e.autocorrelation_time_s.map_or("not measured".into(), |t| format!("{t:.3e} s")))))
+        .collect();
+    let warning = (!named.is_empty()).then(|| {
+        format!(
+            "the averaged rows ({span:.3e} s) hold fewer than two blocks of {BLOCK_TAUS} autocorrelation times of {}: their intervals come from 2 shorter blocks, wide and still maybe too narrow; run longer",
+            named.join(", ")
+        )
+    });
+    ShearSummary { averaged_from_s: kept[0].time_s, shear_stress_pa, normal_stress_pa, stress_ratio, packing_fraction, warning }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Rows of a given tau/sigma series (sigma 1e5 Pa, tau = ratio x sigma), 1 ms apart.
+    fn rows(ratio: impl Iterator<Item = f64>) -> Vec<WallRow> {
+        ratio
+            .enumerate()
+            .map(|(k, x)| {
+                let (tau, sigma) = (x * 1e5, 1e5);
+                // Forces of the grains on the walls for these stresses on a 1 m x 1 m wall.
+                WallRow::new(k as f64 * 1e-3, Vec2::new(tau, -sigma), Vec2::new(-tau, sigma), 0.01, 1.0, 1.0)
+            })
+            .collect()
+    }
+
+    /// Rows that alternate about their mean decorrelate at once: automatic blocks, no
+    /// warning. A slow drift (a ramp over the whole run, autocorrelated across it) leaves
+    /// fewer than two blocks of 8 autocorrelation times: the summary says so, naming the
+    /// quantities.
+    #[test]
+    fn a_run_too_short_for_its_autocorrelation_is_named() {
+        let spec = StatisticsSpec::default();
+        let quick = stress_estimates(&rows((0..400).map(|k| 0.3 + if k % 2 == 0 { 0.01 } else { -0.01 })), None, &spec);
+        assert!(quick.warning.is_none(), "{:?}", quick.warning);
+        assert!(quick.stress_ratio.unwrap().blocks > 2);
+        let drift = stress_estimates(&rows((0..400).map(|k| 0.2 + 1e-3 * k as f64)), None, &spec);
+        let w = drift.warning.expect("a drift over the whole run");
+        assert!(w.contains("tau/sigma") && w.contains("shear stress") && w.contains("run longer"), "{w}");
+        assert_eq!(drift.stress_ratio.unwrap().blocks, 2);
+        // Fixed blocks: the scene asked for them, no warning.
+        let fixed = StatisticsSpec { blocks: crate::scene::BlocksSpec::Count(10), ..spec };
+        assert!(stress_estimates(&rows((0..400).map(|k| 0.2 + 1e-3 * k as f64)), None, &fixed).warning.is_none());
     }
 }

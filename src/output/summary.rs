@@ -79,7 +79,7 @@ pub fn timing_table(s: &Summary) -> String {
     out
 }
 
-/// The run in one line, for a person: how it ended, tau/sigma with its 95% interval and
+/// The run in one line, for a person (and the shear intervals' warning, if any, after it): how it ended, tau/sigma with its 95% interval and
 /// the normal stress (shear), the restitution coefficient (impact), the energy balance's
 /// largest residual, and the rate.
 pub fn headline(s: &Summary) -> String {
@@ -97,5 +97,9 @@ pub fn headline(s: &Summary) -> String {
         parts.push(format!("energy residual {:.1e} of the input", e.max_residual_rel));
     }
     parts.push(format!("{} grains x {} steps in {:.1} s", s.grains, s.steps, s.wall_time_s));
-    parts.join("; ")
+    let mut line = parts.join("; ");
+    if let Some(w) = s.shear.as_ref().and_then(|sh| sh.warning.as_ref()) {
+        line += &format!("\nwarning: {w}");
+    }
+    line
 }
