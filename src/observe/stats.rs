@@ -18,6 +18,20 @@ pub struct Estimate {
     pub autocorrelation_time_s: Option<f64>,
 }
 
+/// t(0.975, dof), Student's t's 97.5% quantile (dof at least 1): a 95% half-width over
+/// a standard error.
+pub fn t975(dof: usize) -> f64 {
+    StudentsT::new(0.0, 1.0, dof.max(1) as f64).expect("dof >= 1").inverse_cdf(0.975)
+}
+
+impl Estimate {
+    /// The standard error of the mean the interval stands for: its half-width over
+    /// t(0.975, blocks - 1).
+    pub fn standard_error(&self) -> f64 {
+        self.ci95 / t975(self.blocks.max(2) - 1)
+    }
+}
+
 /// How many blocks a series is cut into for its confidence interval.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Blocking {
@@ -120,7 +134,7 @@ pub fn block_average(x: &[f64], blocks: usize) -> Estimate {
         return Estimate { mean, ci95: f64::INFINITY, blocks, autocorrelation_time_s: None };
     }
     let var = means.iter().map(|m| (m - mean).powi(2)).sum::<f64>() / (blocks - 1) as f64;
-    let t = StudentsT::new(0.0, 1.0, (blocks - 1) as f64).expect("dof >= 1").inverse_cdf(0.975);
+    let t = t975(blocks - 1);
     Estimate { mean, ci95: t * (var / blocks as f64).sqrt(), blocks, autocorrelation_time_s: None }
 }
 

@@ -5,10 +5,9 @@
 //! packing is chaotic, and a run's block interval does not cover what another seed gives.
 
 use serde::Serialize;
-use statrs::distribution::{ContinuousCDF, StudentsT};
 
 use crate::error::Error;
-use crate::observe::stats::Estimate;
+use crate::observe::stats::{Estimate, t975};
 use crate::scene::limits::Limits;
 use crate::scene::{Analysis, Grains, Scene};
 use crate::study::run::{RunOptions, run_report};
@@ -128,7 +127,7 @@ pub fn ensemble(scene: &Scene, seeds: &[u64], duration: Option<f64>, threads: us
         runs.push(run);
     }
     let done: Vec<&EnsembleRun> = runs.iter().filter(|r| r.status == "completed").collect();
-    let of = |f: &dyn Fn(&EnsembleRun) -> Option<Estimate>| stat(&done.iter().filter_map(|r| f(r)).map(|e| (e.mean, Some((e.ci95, e.blocks)))).collect::<Vec<_>>());
+    let of = |f: &dyn Fn(&EnsembleRun) -> Option<Estimate>| stat(&done.iter().filter_map(|r| f(r)).map(|e| (e.mean, Some((e.ci95, e.standard_error())))).collect::<Vec<_>>());
     Ok(Ensemble {
         scene: scene.name.clone(),
         seeds: seeds.to_vec(),
@@ -140,24 +139,19 @@ pub fn ensemble(scene: &Scene, seeds: &[u64], duration: Option<f64>, threads: us
     })
 }
 
-/// t(0.975, dof), Student's t's 97.5% quantile.
-fn t975(dof: usize) -> f64 {
-    StudentsT::new(0.0, 1.0, dof.max(1) as f64).expect("dof >= 1").inverse_cdf(0.975)
-}
-
-/// The ensemble statistics of the runs' values (each with its block half-width and block
-/// count, if any); none for fewer than two values or a value that is not finite.
-fn stat(values: &[(f64, Option<(f64, usize)>)]) -> Option<EnsembleStat> {
+/// The ensemble statistics of the runs' values (each with its block half-width and
+/// standard error, if any); none for fewer than two values or a value that is not finite.
+fn stat(values: &[(f64, Option<(f64, f64)>)]) -> Option<EnsembleStat> {
     let n = values.len();
     if n < 2 || values.iter().any(|(x, c)| !x.is_finite() || c.is_some_and(|c| !c.0.is_finite())) {
         return None;
     }
     let mean = values.iter().map(|v| v.0).sum::<f64>() / n as f64;
     let std = (values.iter().map(|v| (v.0 - mean).powi(2)).sum::<f64>() / (n - 1) as f64).sqrt();
-    let blocks: Vec<(f64, usize)> = values.iter().filter_map(|v| v.1).collect();
+    let blocks: Vec<(f64, f64)> = values.iter().filter_map(|v| v.1).collect();
     let all = blocks.len() == n;
     let mean_block_ci95 = all.then(|| blocks.iter().map(|b| b.0).sum::<f64>() / n as f64);
-    let mean_block_standard_error = all.then(|| blocks.iter().map(|&(c, k)| c / t975(k.saturating_sub(1))).sum::<f64>() / n as f64);
+    let mean_block_standard_error = all.then(|| blocks.iter().map(|b| b.1).sum::<f64>() / n as f64);
     Some(EnsembleStat {
         runs: n,
         mean,

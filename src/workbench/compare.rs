@@ -135,11 +135,7 @@ pub fn compare_shear(case: &str, code: Code, engine: &ShearSummary, reference: &
 /// width, number of blocks), with the Welch-Satterthwaite degrees of freedom (statrs).
 pub fn welch_p(a: &crate::observe::stats::Estimate, b: &crate::observe::stats::Estimate) -> f64 {
     use statrs::distribution::{ContinuousCDF, StudentsT};
-    let se = |e: &crate::observe::stats::Estimate| {
-        let t = StudentsT::new(0.0, 1.0, (e.blocks.max(2) - 1) as f64).expect("dof >= 1").inverse_cdf(0.975);
-        e.ci95 / t
-    };
-    let (sa, sb) = (se(a), se(b));
+    let (sa, sb) = (a.standard_error(), b.standard_error());
     let (va, vb) = (sa * sa, sb * sb);
     if va + vb == 0.0 {
         return if a.mean == b.mean { 1.0 } else { 0.0 };
