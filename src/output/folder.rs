@@ -129,6 +129,20 @@ fn name_some(names: &[String]) -> String {
     s
 }
 
+/// The manifest of grainlab's in `dir`, if there is one: read only if a regular file of
+/// sane size (a pipe named like it would never end), and of this [`FORMAT`].
+fn read_manifest(dir: &Path) -> Option<Manifest> {
+    crate::scene::limits::read_bounded(&dir.join(MANIFEST), MAX_MANIFEST_BYTES, MANIFEST).ok().and_then(|t| serde_json::from_str(&t).ok()).filter(|m: &Manifest| m.format == FORMAT)
+}
+
+/// Delete the file `path`; one that is not there is no error.
+fn remove_if_there(path: &Path) -> Result<(), Error> {
+    match std::fs::remove_file(path) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(Error::io(path.display(), e)),
+        _ => Ok(()),
+    }
+}
+
 /// What claiming a folder will delete: files, then folders (deepest first).
 struct Clearing {
     files: Vec<String>,
@@ -149,12 +163,7 @@ fn inspect(dir: &Path, overwrite: bool) -> Result<Clearing, Error> {
     if entries.is_empty() {
         return Ok(nothing);
     }
-    // Read only if a regular file of sane size (a pipe named like it would never end).
-    let manifest: Option<Manifest> = crate::scene::limits::read_bounded(&dir.join(MANIFEST), MAX_MANIFEST_BYTES, MANIFEST)
-        .ok()
-        .and_then(|t| serde_json::from_str(&t).ok())
-        .filter(|m: &Manifest| m.format == FORMAT);
-    let Some(manifest) = manifest else {
+    let Some(manifest) = read_manifest(dir) else {
         let names: Vec<String> = entries.iter().map(|e| e.0.clone()).collect();
         return refuse(format!(
             "it holds files grainlab did not write ({}): grainlab writes only into a new or empty folder, or one it wrote itself (its {MANIFEST} lists what it wrote)",
@@ -239,11 +248,7 @@ impl OutFolder {
         // The old manifest goes last (replaced by the new one), so that a process that
         // dies while clearing leaves a folder whose manifest lists what is left.
         for f in clearing.files.iter().filter(|f| *f != MANIFEST) {
-            let path = dir.join(f);
-            match std::fs::remove_file(&path) {
-                Err(e) if e.kind() != std::io::ErrorKind::NotFound => return Err(Error::io(path.display(), e)),
-                _ => {}
-            }
+            remove_if_there(&dir.join(f))?;
         }
         for f in &clearing.folders {
             let path = dir.join(f);
@@ -262,9 +267,7 @@ impl OutFolder {
     /// deleted and unlisted, so that nothing in the folder mixes the two runs.
     pub fn reopen(dir: &Path, frames_kept: &[String]) -> Result<Self, Error> {
         let refuse = |why: String| Err(Error::Folder { dir: dir.display().to_string(), why });
-        let manifest: Option<Manifest> =
-            crate::scene::limits::read_bounded(&dir.join(MANIFEST), MAX_MANIFEST_BYTES, MANIFEST).ok().and_then(|t| serde_json::from_str(&t).ok()).filter(|m: &Manifest| m.format == FORMAT);
-        let Some(mut manifest) = manifest else {
+        let Some(mut manifest) = read_manifest(dir) else {
             return refuse(format!("has no {MANIFEST} of grainlab's: it is not a run's output folder"));
         };
         if manifest.status == "completed" {
@@ -272,11 +275,7 @@ impl OutFolder {
         }
         let gone = |p: &str| p == "summary.json" || p == "force_overlap.csv" || p == "force_overlap.csv.part" || (p.starts_with("frames/") && !frames_kept.iter().any(|f| f == p));
         for f in manifest.files.iter().filter(|f| gone(&f.path)) {
-            let path = dir.join(&f.path);
-            match std::fs::remove_file(&path) {
-                Err(e) if e.kind() != std::io::ErrorKind::NotFound => return Err(Error::io(path.display(), e)),
-                _ => {}
-            }
+            remove_if_there(&dir.join(&f.path))?;
         }
         manifest.files.retain(|f| !gone(&f.path));
         manifest.status = "running".into();
@@ -380,11 +379,7 @@ impl OutFolder {
 
     /// Delete the file `rel`, if there, and unlist it.
     pub fn remove(&mut self, rel: &str) -> Result<(), Error> {
-        let path = self.dir.join(rel);
-        match std::fs::remove_file(&path) {
-            Err(e) if e.kind() != std::io::ErrorKind::NotFound => return Err(Error::io(path.display(), e)),
-            _ => {}
-        }
+        remove_if_there(&self.dir.join(rel))?;
         self.manifest.files.retain(|f| f.path != rel);
         Ok(())
     }
