@@ -270,11 +270,8 @@ fn execute(cli: Cli) -> Result<(), Error> {
         Command::Run { scene, out, overwrite, duration, quiet, threads, checkpoint_every } => {
             let scene = load_scene(&scene)?;
             check_duration(duration)?;
-            if let Some(s) = checkpoint_every {
-                // Refused before a long build (the run checks the same).
-                grainlab::error::check_option(s.is_finite() && s > 0.0, "--checkpoint-every", s, "> 0 s of simulated time")?;
-                grainlab::error::check_option(out.is_some(), "--checkpoint-every", s, "with an output folder (--out) to write the checkpoints in")?;
-            }
+            // Refused before a long build (the run checks the same).
+            grainlab::study::run::check_checkpoint_every(checkpoint_every, out.is_some())?;
             if let Some(dir) = &out {
                 // Refused before a long build; the run claims the folder when it starts.
                 OutFolder::check(dir, overwrite)?;

@@ -126,12 +126,18 @@ impl CsvSeries {
             return Err(Error::Checkpoint { file: part.display().to_string(), why: format!("holds {len} bytes, the checkpoint needs its first {bytes}: it was cut after the checkpoint was written") });
         }
         file.set_len(bytes).map_err(|e| Error::io(part.display(), e))?;
+        // The checksum of what is kept, read a piece at a time (a series may be large);
+        // the reads leave the file at its end, where the rows go on.
         let mut crc = crc32fast::Hasher::new();
-        let mut kept = Vec::new();
-        std::io::Read::read_to_end(&mut file, &mut kept).map_err(|e| Error::io(part.display(), e))?;
-        crc.update(&kept);
-        use std::io::Seek as _;
-        file.seek(std::io::SeekFrom::End(0)).map_err(|e| Error::io(part.display(), e))?;
+        let mut piece = vec![0u8; 1 << 16];
+        loop {
+            match std::io::Read::read(&mut file, &mut piece) {
+                Ok(0) => break,
+                Ok(n) => crc.update(&piece[..n]),
+                Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+                Err(e) => return Err(Error::io(part.display(), e)),
+            }
+        }
         let out = Counted { file, bytes, crc };
         Ok(CsvSeries { out, path: part, final_path: Some(path.to_path_buf()), header: bytes > 0 })
     }

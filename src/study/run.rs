@@ -160,7 +160,7 @@ pub fn resume(dir: &Path, threads: Option<usize>, opts: &RunOptions) -> Result<R
     let mut folder = OutFolder::reopen(dir, &state.frames.iter().map(|f| f.1.clone()).collect::<Vec<_>>())?;
     let energy = state.energy_bytes.map(|b| folder.resume_series("energy.csv", b)).transpose()?;
     let walls = state.walls_bytes.map(|b| folder.resume_series("walls.csv", b)).transpose()?;
-    let vtk = if state.frames_on { Some(VtkSeries::resume(state.frames.clone(), &mut folder)?) } else { None };
+    let vtk = if state.frames.is_empty() { None } else { Some(VtkSeries::resume(state.frames.clone(), &mut folder)?) };
     let opts = RunOptions { out: Some(dir.to_path_buf()), duration: c.duration, checkpoint_every: opts.checkpoint_every.or(c.every_s), ..opts.clone() };
     let outputs = Outputs { folder: Some(folder), energy, walls, vtk };
     drive(&scene, built, &opts, Some((outputs, state)))
@@ -188,8 +188,8 @@ struct LoopState {
     /// Bytes of energy.csv and walls.csv written (none: the run writes no such series).
     energy_bytes: Option<u64>,
     walls_bytes: Option<u64>,
-    /// The run writes frames, and those written (time, s; file).
-    frames_on: bool,
+    /// The frames written (time, s; file): none when the run writes none (a run that
+    /// does has written its first before any checkpoint).
     frames: Vec<(f64, String)>,
     /// When the run started (seconds since the Unix epoch), and the wall-clock time its
     /// earlier parts took, s.
@@ -227,17 +227,26 @@ impl LoopState {
     }
 }
 
-/// What a checkpoint records besides the states: the run's scene as built, its
-/// `--duration`, and the rate.
-struct Checkpointing {
-    scene: String,
+/// `--checkpoint-every`'s value (s of simulated time), if given, checked: above 0, and
+/// with an output folder (`out`) to write in.
+pub fn check_checkpoint_every(every: Option<f64>, out: bool) -> Result<(), Error> {
+    let Some(s) = every else { return Ok(()) };
+    crate::error::check_option(s.is_finite() && s > 0.0, "--checkpoint-every", s, "> 0 s of simulated time")?;
+    crate::error::check_option(out, "--checkpoint-every", s, "with an output folder (--out) to write the checkpoints in")
+}
+
+/// What a checkpoint records besides the states: the run's scene as built (encoded at
+/// the first checkpoint), its `--duration`, and the rate.
+struct Checkpointing<'a> {
+    scene: &'a Scene,
+    json: std::cell::OnceCell<String>,
     duration: Option<f64>,
     every_s: Option<f64>,
     /// Steps between checkpoints (none: only a stop request writes one).
     every: Option<u64>,
 }
 
-impl Checkpointing {
+impl Checkpointing<'_> {
     /// Write `checkpoint.bin` for the state after this step: the series flushed and synced
     /// first (the checkpoint holds their lengths), then the checkpoint, synced and renamed.
     fn write(&self, e: &dyn Engine, out: &mut Outputs, st: &mut LoopState, wall_time_s: f64) -> Result<(), Error> {
@@ -251,7 +260,7 @@ impl Checkpointing {
         let c = Checkpoint {
             grainlab: env!("CARGO_PKG_VERSION").into(),
             commit: env!("GRAINLAB_COMMIT").into(),
-            scene: self.scene.clone(),
+            scene: self.json.get_or_init(|| serde_json::to_string(&resolved(self.scene, self.scene.duration)).expect("serialisable")).clone(),
             duration: self.duration,
             threads: e.threads(),
             every_s: self.every_s,
@@ -272,16 +281,9 @@ fn drive(scene: &Scene, mut built: Built, opts: &RunOptions, resumed: Option<(Ou
     // The build checked the scene's duration; an override is checked here, and cuts a
     // protocol short.
     step_count(duration, dt, if opts.duration.is_some() { "--duration" } else { "duration" })?;
-    let every = match opts.checkpoint_every {
-        None => None,
-        Some(s) => {
-            crate::error::check_option(s.is_finite() && s > 0.0, "--checkpoint-every", s, "> 0 s of simulated time")?;
-            crate::error::check_option(opts.out.is_some(), "--checkpoint-every", s, "with an output folder (--out) to write the checkpoints in")?;
-            Some(((s / dt).round() as u64).max(1))
-        }
-    };
-    let checkpointing = Checkpointing { scene: String::new(), duration: opts.duration, every_s: opts.checkpoint_every, every };
-    let checkpointing = Checkpointing { scene: if opts.out.is_some() { serde_json::to_string(&resolved(scene, scene.duration)).expect("serialisable") } else { String::new() }, ..checkpointing };
+    check_checkpoint_every(opts.checkpoint_every, opts.out.is_some())?;
+    let every = opts.checkpoint_every.map(|s| ((s / dt).round() as u64).max(1));
+    let checkpointing = Checkpointing { scene, json: std::cell::OnceCell::new(), duration: opts.duration, every_s: opts.checkpoint_every, every };
     let cut;
     let scene = if opts.duration.is_some() {
         cut = scene.truncated(duration);
@@ -317,7 +319,6 @@ fn drive(scene: &Scene, mut built: Built, opts: &RunOptions, resumed: Option<(Ou
                 outputs.folder = Some(folder);
             }
             let st = LoopState {
-                frames_on: outputs.vtk.is_some(),
                 impact: (scene.analysis == Analysis::Impact).then(ImpactObserver::default),
                 started_unix_s: now.duration_since(std::time::UNIX_EPOCH).map_or(0.0, |d| d.as_secs_f64()),
                 ..LoopState::default()
