@@ -39,3 +39,24 @@ fn the_loaded_wall_carries_the_requested_stress() {
     let ratio = sh.stress_ratio.expect("tau/sigma is defined under a load");
     assert!(ratio.mean > 0.1 && ratio.mean < 0.5, "{ratio:?}");
 }
+
+/// `statistics` is refused by name: its JSON path, the value and what is allowed.
+#[test]
+fn statistics_out_of_range_are_refused_by_name() {
+    let scene = |statistics: serde_json::Value| {
+        let mut v = serde_json::to_value(shear()).unwrap();
+        v["statistics"] = statistics;
+        grainlab::Scene::from_json(&v.to_string()).and_then(|s| s.validate().map(|()| s))
+    };
+    let refused = |statistics: serde_json::Value, expect: &str| {
+        let e = scene(statistics).unwrap_err().to_string();
+        assert!(e.contains(expect), "expected `{expect}` in: {e}");
+    };
+    refused(serde_json::json!({"average_from": 1.0}), "statistics.average_from = 1; allowed: a fraction of the averaged rows, 0 <= f < 1");
+    refused(serde_json::json!({"blocks": 1}), "statistics.blocks = 1; allowed: \"auto\", or 2 to 1000 blocks");
+    refused(serde_json::json!({"blocks": "many"}), "at `statistics.blocks`: invalid value: string \"many\", expected \"auto\" or a number of blocks (2 to 1000)");
+    refused(serde_json::json!({"blocks": -3}), "expected \"auto\" or a number of blocks (2 to 1000)");
+    let s = scene(serde_json::json!({"blocks": 12, "average_from": 0.25})).unwrap();
+    assert_eq!((s.statistics.blocks, s.statistics.average_from), (grainlab::scene::BlocksSpec::Count(12), 0.25));
+    assert_eq!(scene(serde_json::json!({})).unwrap().statistics, grainlab::scene::StatisticsSpec::default());
+}

@@ -449,7 +449,7 @@ impl Default for StatisticsSpec {
 }
 
 /// `"auto"` or a number of blocks ([`StatisticsSpec::blocks`]).
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, JsonSchema)]
 #[serde(untagged)]
 pub enum BlocksSpec {
     Auto(AutoBlocks),
@@ -461,6 +461,31 @@ pub enum BlocksSpec {
 #[serde(rename_all = "snake_case")]
 pub enum AutoBlocks {
     Auto,
+}
+
+/// Read by hand so that a wrong value is refused saying what is allowed (an untagged
+/// enum's derived reader says only that no variant matched).
+impl<'de> Deserialize<'de> for BlocksSpec {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        use serde::de::{Error, Unexpected, Visitor};
+        struct Blocks;
+        impl Visitor<'_> for Blocks {
+            type Value = BlocksSpec;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("\"auto\" or a number of blocks (2 to 1000)")
+            }
+            fn visit_str<E: Error>(self, s: &str) -> Result<BlocksSpec, E> {
+                if s == "auto" { Ok(BlocksSpec::Auto(AutoBlocks::Auto)) } else { Err(E::invalid_value(Unexpected::Str(s), &self)) }
+            }
+            fn visit_u64<E: Error>(self, n: u64) -> Result<BlocksSpec, E> {
+                Ok(BlocksSpec::Count(n))
+            }
+            fn visit_i64<E: Error>(self, n: i64) -> Result<BlocksSpec, E> {
+                u64::try_from(n).map(BlocksSpec::Count).map_err(|_| E::invalid_value(Unexpected::Signed(n), &self))
+            }
+        }
+        d.deserialize_any(Blocks)
+    }
 }
 
 impl Default for BlocksSpec {
