@@ -13,11 +13,13 @@ use grainlab::output::checkpoint::{CHECKPOINT, Checkpoint};
 use grainlab::scene::Scene;
 use grainlab::study::run::{RunOptions, RunReport, resume, run_report};
 
-/// The workbench's two-stage protocol (200 grains under 100 kPa, shear at +-0.5 m/s then
-/// +-1 m/s) made short, with frames: stages, a loaded wall, frames and rows all cross
-/// the stops.
+/// The workbench's protocol (200 grains under 100 kPa, shear at +-0.5 m/s then +-1 m/s),
+/// its first two stages made longer and sampled less often, with frames: stages, a loaded
+/// wall, frames and rows all cross the stops.
 fn protocol() -> Scene {
     let mut s = grainlab::workbench::cases::protocol_case();
+    s.stages.truncate(2);
+    s.stages[0].samples = Some(100);
     s.stages[0].duration = 4e-4;
     s.stages[1].duration = 8e-4;
     s.stages[1].samples = Some(40);

@@ -93,25 +93,41 @@ pub fn cases() -> Vec<Case> {
     out.push(Case { info: CaseInfo { name: "shear/yade".into(), description: s.description.clone(), codes: vec![Code::Yade], quick: false, curve: false }, scene: s });
     let s = protocol_case();
     out.push(Case { info: CaseInfo { name: "protocol/liggghts".into(), description: s.description.clone(), codes: vec![Code::Liggghts], quick: true, curve: false }, scene: s });
+    let mut s = builtin::protocol();
+    s.model.lever_arm = LeverArm::RadiusMinusHalfOverlap;
+    s.name = "protocol-builtin-liggghts".into();
+    s.description = "the built-in protocol (compress to 100 kPa, relax, shear at +-0.5 m/s, then at +-2 m/s; 1000 grains) with LIGGGHTS' lever arm: its last stage's averages".into();
+    s.output.frames = 0;
+    out.push(Case { info: CaseInfo { name: "protocol/builtin".into(), description: s.description.clone(), codes: vec![Code::Liggghts], quick: false, curve: false }, scene: s });
     out
 }
 
-/// A two-stage protocol in a 200-grain shear cell, with LIGGGHTS' lever arm, under
-/// 100 kPa: sheared at +-0.5 m/s from the start (2 ms, not averaged), then at +-1 m/s
-/// (10 ms, 400 rows, averaged). LIGGGHTS runs the same two stages from the exported deck;
-/// the second stage's time averages are compared as the shear cells'.
+/// The workbench's protocol: a 200-grain shear cell, with LIGGGHTS' lever arm, under
+/// 100 kPa, packed loosely (area fraction 0.6, so no two grains touch at the start). The
+/// top wall falls onto the grains; 54 us in, while it first presses on them, the walls
+/// go from +-0.5 m/s ("slow") to +-1 m/s ("fast", 16 us), every step of both recorded;
+/// the run goes on at +-1 m/s ("steady", 10 ms, 400 rows, averaged). LIGGGHTS runs the
+/// same stages from the exported deck: the two codes' rows of the first two stages agree
+/// step for step (tests/workbench.rs, `a_protocol_agrees_step_for_step_...`), the steady
+/// stage's time averages as the shear cells' do.
 pub fn protocol_case() -> Scene {
-    use crate::scene::{StageSpec, StageWalls, WallChange};
+    use crate::scene::{Grains, StageSpec, StageWalls, WallChange};
     let mut s = builtin::shear_cell(200, 0.008);
+    if let Grains::Pack(p) = &mut s.grains {
+        p.packing_fraction = 0.6;
+    }
     s.model.lever_arm = LeverArm::RadiusMinusHalfOverlap;
     s.name = "protocol-liggghts".into();
-    s.description = "a two-stage protocol (shear at +-0.5 m/s, then at +-1 m/s, under 100 kPa) in a 200-grain shear cell, with LIGGGHTS' lever arm".into();
+    s.description = "a three-stage protocol (shear at +-0.5 m/s while the top wall lands, then at +-1 m/s, every step recorded; then 10 ms at +-1 m/s, averaged) under 100 kPa in a loose 200-grain shear cell, with LIGGGHTS' lever arm".into();
     s.output.frames = 0;
     s.time_step.rule = crate::scene::TimeStepRule::StepsPerContact { steps: 50.0, impact_speed: 1.0 };
     let vx = |v: f64| WallChange { velocity_x: Some(v), ..WallChange::default() };
+    // More samples than steps: a row at every step.
+    let every_step = Some(100_000);
     s.stages = vec![
-        StageSpec { name: "slow".into(), duration: 0.002, samples: Some(100), average: false, ..StageSpec::default() },
-        StageSpec { name: "fast".into(), duration: 0.01, walls: StageWalls { bottom: vx(-1.0), top: vx(1.0) }, samples: Some(400), average: true, ..StageSpec::default() },
+        StageSpec { name: "slow".into(), duration: 54e-6, samples: every_step, average: false, ..StageSpec::default() },
+        StageSpec { name: "fast".into(), duration: 16e-6, walls: StageWalls { bottom: vx(-1.0), top: vx(1.0) }, samples: every_step, average: false, ..StageSpec::default() },
+        StageSpec { name: "steady".into(), duration: 0.01, samples: Some(400), average: true, ..StageSpec::default() },
     ];
     s.duration = s.stages.iter().map(|st| st.duration).sum();
     s

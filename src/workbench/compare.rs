@@ -8,11 +8,11 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::Error;
 use crate::observe::impact::{CurvePoint, ImpactSummary};
-use crate::observe::stress::ShearSummary;
+use crate::observe::stress::{ShearSummary, WallRow};
 use crate::scene::{Analysis, Scene};
 use crate::study::run::{RunOptions, run_scene};
 use crate::workbench::cases::read_info;
-use crate::workbench::export::Code;
+use crate::workbench::export::{Code, ExportInfo};
 
 /// One compared quantity.
 #[derive(Clone, Debug, Serialize)]
@@ -56,6 +56,14 @@ pub mod tolerance {
     pub const PEAK: f64 = 1e-4;
     /// Rebound spin and tangential velocity, relative (issue bound).
     pub const SPIN: f64 = 1e-3;
+    /// A protocol's rows recorded at every step, before chaos: the wall forces as a
+    /// fraction of the top wall's load, and the gap, relative. The same model at the same
+    /// steps computes the same trajectory up to the order of its sums, which the contacts
+    /// amplify: 6e-13 of the load at worst over the workbench protocol's 1381 steps. The
+    /// first contact that opens and touches again before a neighbour-list rebuild ends
+    /// that (LIGGGHTS keeps its stale tangential history, docs/fidelity.md), with jumps
+    /// of 1e-5 to 1e-3 of the load; 1e-9 lies between.
+    pub const STEPS: f64 = 1e-9;
 }
 
 /// The engine's impact summary for a case's scene.
@@ -149,7 +157,7 @@ pub fn welch_p(a: &crate::observe::stats::Estimate, b: &crate::observe::stats::E
 
 /// Run the engine on a committed case and compare it with every code that has data.
 pub fn compare_case(case_dir: &Path) -> Result<Vec<Row>, Error> {
-    let (case, _) = read_info(case_dir)?;
+    let (case, info) = read_info(case_dir)?;
     let text = std::fs::read_to_string(case_dir.join("scene.json")).map_err(|e| Error::io(case_dir.join("scene.json").display(), e))?;
     let scene = Scene::from_json(&text)?;
     let mut rows = Vec::new();
@@ -178,13 +186,81 @@ pub fn compare_case(case_dir: &Path) -> Result<Vec<Row>, Error> {
             }
         }
         Analysis::Shear => {
-            let s = run_scene(&scene, &RunOptions::default())?.shear.ok_or_else(|| Error::Other("no shear summary".into()))?;
+            // A protocol that records stages at every step: the engine's rows too, from a
+            // run with an output folder (removed after).
+            let stepped = info.stages.iter().any(|st| st.sample_every == 1);
+            let folder = stepped.then(|| std::env::temp_dir().join(format!("grainlab-compare-{}-{}", std::process::id(), case.name.replace('/', "-"))));
+            let run = run_scene(&scene, &RunOptions { out: folder.clone(), overwrite: true, ..RunOptions::default() });
+            let engine_rows = folder.as_ref().map(|f| read_wall_rows(&f.join("walls.csv")));
+            if let Some(f) = &folder {
+                let _ = std::fs::remove_dir_all(f);
+            }
+            let s = run?.shear.ok_or_else(|| Error::Other("no shear summary".into()))?;
             for code in codes {
                 rows.extend(compare_shear(&case.name, code, &s, &expected_shear(case_dir, code)?));
+                if let Some(engine_rows) = &engine_rows {
+                    let engine_rows = engine_rows.as_ref().map_err(|e| Error::Other(e.to_string()))?;
+                    let reference = read_wall_rows(&case_dir.join("expected").join(code.name()).join("stress.csv"))?;
+                    rows.extend(compare_steps(&case.name, code, &info, load_of(&scene, &info), engine_rows, &reference)?);
+                }
             }
         }
         Analysis::None => {}
     }
+    Ok(rows)
+}
+
+/// A wall series (walls.csv, or a digest's stress.csv).
+fn read_wall_rows(path: &Path) -> Result<Vec<WallRow>, Error> {
+    let mut r = ::csv::Reader::from_path(path).map_err(|e| Error::Other(format!("{}: {e}", path.display())))?;
+    r.deserialize().collect::<Result<Vec<WallRow>, _>>().map_err(|e| Error::Other(format!("{}: {e}", path.display())))
+}
+
+/// The load on the top wall, N (the scale of the wall forces): its pressure times the
+/// walls' area L_x t; without one, the largest force of the rows compared is used instead.
+fn load_of(scene: &Scene, info: &ExportInfo) -> Option<f64> {
+    match scene.walls.as_ref().map(|w| &w.top.control) {
+        Some(crate::scene::ControlSpec::Pressure(p)) => Some(p * info.length_m * info.depth_m),
+        _ => None,
+    }
+}
+
+/// Compare a protocol's rows of the stages recorded at every step, row by row: each wall
+/// force's largest difference over them as a fraction of the top wall's load (`load`, N;
+/// else of the largest force in those rows), and the gap's, relative
+/// ([`tolerance::STEPS`]). Rows are matched by their step; a missing or extra row is an
+/// error.
+pub fn compare_steps(case: &str, code: Code, info: &ExportInfo, load: Option<f64>, engine: &[WallRow], reference: &[WallRow]) -> Result<Vec<Row>, Error> {
+    if engine.len() != reference.len() {
+        return Err(Error::Other(format!("{case}: the engine wrote {} rows, {} {}", engine.len(), code.name(), reference.len())));
+    }
+    let dt = info.time_step_s;
+    let in_stepped = |t: f64| info.stages.iter().any(|st| st.sample_every == 1 && t > st.first_step as f64 * dt && t <= (st.first_step + st.steps) as f64 * dt);
+    let mut pairs = Vec::new();
+    for (k, (a, b)) in engine.iter().zip(reference).enumerate() {
+        if (a.time_s - b.time_s).abs() > 1e-9 * dt {
+            return Err(Error::Other(format!("{case}: row {} is at {} s in the engine, {} s in {}", k + 1, a.time_s, b.time_s, code.name())));
+        }
+        if in_stepped(b.time_s) {
+            pairs.push((a, b));
+        }
+    }
+    if pairs.is_empty() {
+        return Ok(Vec::new());
+    }
+    let forces = |r: &WallRow| [r.bottom_fx_n, r.bottom_fy_n, r.top_fx_n, r.top_fy_n];
+    let scale = load.unwrap_or_else(|| pairs.iter().flat_map(|(_, b)| forces(b)).fold(0.0, |m: f64, f| m.max(f.abs())));
+    let names = ["bottom_fx_n", "bottom_fy_n", "top_fx_n", "top_fy_n"];
+    let mut rows = Vec::new();
+    for (j, name) in names.iter().enumerate() {
+        // The row where the two differ most, its difference over the scale.
+        let (a, b) = pairs.iter().map(|(a, b)| (forces(a)[j], forces(b)[j])).max_by(|x, y| (x.0 - x.1).abs().total_cmp(&(y.0 - y.1).abs())).expect("rows");
+        let mut r = Row::new(case, code, &format!("{name}_each_step_of_{}_over_load", pairs.len()), a / scale, b / scale, tolerance::STEPS, false);
+        r.rel_diff = None;
+        rows.push(r);
+    }
+    let (a, b) = pairs.iter().map(|(a, b)| (a.gap_m, b.gap_m)).max_by(|x, y| (x.0 - x.1).abs().total_cmp(&(y.0 - y.1).abs())).expect("rows");
+    rows.push(Row::new(case, code, &format!("gap_m_each_step_of_{}", pairs.len()), a, b, tolerance::STEPS, true));
     Ok(rows)
 }
 

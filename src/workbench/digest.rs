@@ -51,10 +51,11 @@ pub fn digest(case_dir: &Path, code: Code, run_dir: &Path) -> Result<PathBuf, Er
         }
         Analysis::Shear => {
             let (_, rows) = read_table(&run_dir.join("walls.txt"))?;
-            let series: Vec<WallRow> = rows
-                .iter()
-                .map(|r| WallRow::new(r[0] * info.time_step_s, Vec2::new(r[1], r[2]), Vec2::new(r[3], r[4]), r[5], info.length_m, info.depth_m))
-                .collect();
+            let series = if info.stages.is_empty() {
+                rows.iter().map(|r| WallRow::new(r[0] * info.time_step_s, Vec2::new(r[1], r[2]), Vec2::new(r[3], r[4]), r[5], info.length_m, info.depth_m)).collect()
+            } else {
+                protocol_rows(&info, &rows).map_err(|e| Error::Other(format!("{}: {e}", run_dir.join("walls.txt").display())))?
+            };
             if series.len() < 4 {
                 return Err(Error::Other(format!("{}: fewer than 4 rows", run_dir.join("walls.txt").display())));
             }
@@ -64,7 +65,11 @@ pub fn digest(case_dir: &Path, code: Code, run_dir: &Path) -> Result<PathBuf, Er
             }
             // A protocol's averages are its last averaged stage's, as grainlab's summary.
             let averaged: Vec<WallRow> = match info.stages.iter().rev().find(|st| st.average) {
-                Some(st) => rows.iter().zip(&series).filter(|(r, _)| r[0] > st.first_step as f64 && r[0] <= (st.first_step + st.steps) as f64).map(|(_, w)| *w).collect(),
+                Some(st) => {
+                    // (Row times are step x dt, as these bounds.)
+                    let (from, to) = (st.first_step as f64 * info.time_step_s, (st.first_step + st.steps) as f64 * info.time_step_s);
+                    series.iter().filter(|r| r.time_s > from && r.time_s <= to).copied().collect()
+                }
                 None => series.clone(),
             };
             if averaged.len() < 4 {
@@ -74,6 +79,39 @@ pub fn digest(case_dir: &Path, code: Code, run_dir: &Path) -> Result<PathBuf, Er
                 .map_err(|e| Error::io(out.display(), e))?;
         }
         Analysis::None => return Err(Error::Other("export.json: analysis none".into())),
+    }
+    Ok(out)
+}
+
+/// A protocol's rows as grainlab writes them, from a deck's row of every step (step,
+/// forces on the bottom and top walls, gap): in each stage a row every `sample_every` of
+/// its steps and at its last, the forces averaged over the row's steps, the gap at its
+/// last, as [`crate::observe::stress::WallAverager`] does.
+fn protocol_rows(info: &ExportInfo, rows: &[Vec<f64>]) -> Result<Vec<WallRow>, String> {
+    let total: u64 = info.stages.iter().map(|st| st.steps).sum();
+    if rows.len() as u64 != total {
+        return Err(format!("{} rows, but a protocol's deck records each of its {total} steps", rows.len()));
+    }
+    let mut out = Vec::new();
+    let mut k = 0;
+    for st in &info.stages {
+        let (mut sum, mut n) = ([Vec2::zeros(); 2], 0u32);
+        for j in 1..=st.steps {
+            let r = &rows[k];
+            k += 1;
+            let step = st.first_step + j;
+            if r[0] != step as f64 {
+                return Err(format!("row {k} is step {}, expected step {step}", r[0]));
+            }
+            sum[0] += Vec2::new(r[1], r[2]);
+            sum[1] += Vec2::new(r[3], r[4]);
+            n += 1;
+            if j % st.sample_every == 0 || j == st.steps {
+                let time = step as f64 * info.time_step_s;
+                out.push(WallRow::new(time, sum[0] / n as f64, sum[1] / n as f64, r[5], info.length_m, info.depth_m));
+                (sum, n) = ([Vec2::zeros(); 2], 0);
+            }
+        }
     }
     Ok(out)
 }

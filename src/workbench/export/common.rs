@@ -70,6 +70,9 @@ pub struct ExportStage {
     pub name: String,
     pub first_step: u64,
     pub steps: u64,
+    /// grainlab's rows: one every this many of the stage's steps, and at its last (the
+    /// decks record every step of a protocol; the digest averages them into these rows).
+    pub sample_every: u64,
     pub average: bool,
 }
 

@@ -301,28 +301,28 @@ pub const FIELDS: &[Field] = &[
         "analysis",
         written("what the deck records: impact, series.txt at every step; shear, walls.txt; none, nothing (a deck to time or to watch); export.json analysis and columns (an impact without two grains, or a grain and a flat wall, is refused by the scene's own checks)"),
     ),
-    each("stages[].name", written("a `# stage K: NAME` comment and the title line of the stage's rows in walls.txt; export.json stages"), written("the STAGES list; export.json stages")),
+    each("stages[].name", written("a `# stage K: NAME` comment before the stage's run; export.json stages"), written("the STAGES list; export.json stages")),
     each(
         "stages[].duration",
-        written("the stage's `run N` (N = ceil(duration / dt)) after `reset_timestep 0`, the printed step offset by the steps before; export.json stages").or_refused(STAGES_FLAT),
-        written("the stage's steps and first step in STAGES; export.json stages").or_refused(STAGES_OPEN),
+        written("the stage's `run N` (N = ceil(duration / dt); `pre no` where only velocities change, so that LIGGGHTS keeps the last step's forces for the first half kick as grainlab does); export.json stages").or_refused(STAGES_FLAT),
+        written("the stage's steps and first step in STAGES (its changes made at that step, one `O.run` for the protocol); export.json stages").or_refused(STAGES_OPEN),
     ),
     each(
         "stages[].walls.bottom.velocity_x",
         written("`velocity bottom set VX ...` on the row before the stage's run (the held row keeps it)"),
-        written("the bottom row's state.vel in STAGES, set before the stage's run"),
+        written("the bottom row's state.vel in STAGES, set at the stage's first step after its forces are recorded, before NewtonIntegrator"),
     ),
     each(
         "stages[].walls.bottom.velocity_y",
         written("`velocity bottom set ... VY ...` on the row before the stage's run"),
-        written("the bottom row's state.vel in STAGES, set before the stage's run"),
+        written("the bottom row's state.vel in STAGES, set at the stage's first step after its forces are recorded, before NewtonIntegrator"),
     ),
     both("stages[].walls.bottom.control", one_value(BOTTOM_CONTROL)),
     both("stages[].walls.bottom.control.pressure", one_value(BOTTOM_CONTROL)),
     each(
         "stages[].walls.top.velocity_x",
         written("`velocity top set VX ...` on the row before the stage's run"),
-        written("the top clump's state.vel in STAGES, set before the stage's run"),
+        written("the top clump's state.vel in STAGES, set at the stage's first step after its forces are recorded, before NewtonIntegrator"),
     ),
     each(
         "stages[].walls.top.velocity_y",
@@ -331,7 +331,8 @@ pub const FIELDS: &[Field] = &[
     ),
     each(
         "stages[].walls.top.control",
-        written("\"fixed\": the row's `aveforce` removed and `setforce 0.0 0.0 0.0`, its y velocity set; a pressure: `setforce 0.0 NULL 0.0` and `aveforce`"),
+        written("\"fixed\": the row's `aveforce` removed and `setforce 0.0 0.0 0.0`, its y velocity set; a pressure: `setforce 0.0 NULL 0.0` and `aveforce`")
+            .or_differs("a change of control after the first stage", "the fixes are replaced, so the stage's run needs LIGGGHTS' setup, which recomputes the forces at the step-end velocities (the stage's new wall velocities included) and rebuilds the neighbour list: the stage's first half kick differs from grainlab's (which uses the last step's forces), an O(dt) difference of one step"),
         written("\"fixed\": the clump blocked in y (`xyzXYZ`) at its velocity, no load; a pressure: free in y (`xzXYZ`) under setPermF"),
     ),
     each(
@@ -342,8 +343,8 @@ pub const FIELDS: &[Field] = &[
     each("stages[].gravity", refused(STAGE_GRAVITY), refused(STAGE_GRAVITY)),
     each(
         "stages[].samples",
-        written("the stage's `fix ave/time 1 K K` and `fix print K` (K = steps / samples), re-created at its start"),
-        written("the stage's SAMPLE in STAGES (the row sums restart with the stage)"),
+        written("export.json stages[].sample_every (steps / samples): the deck prints every step of a protocol, and the digest averages those rows into the stage's"),
+        written("export.json stages[].sample_every (steps / samples): the script records every step of a protocol, and the digest averages those rows into the stage's"),
     ),
     both("stages[].frames", outside(NOT_PHYSICS_OUTPUT)),
     both("stages[].average", written("export.json stages[].average: the digest averages the last averaged stage's rows, as grainlab's summary")),

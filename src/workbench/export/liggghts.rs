@@ -92,14 +92,16 @@ pub(crate) fn deck(scene: &Scene, ex: &Exported) -> Result<String, Error> {
                 match wall.control {
                     Control::Fixed => {
                         let _ = writeln!(w, "fix f_{name} {name} setforce 0.0 0.0 0.0");
-                        wall_vars.push((name, format!("f_f_{name}[1]"), format!("f_f_{name}[2]"), a));
                     }
                     Control::Load { force } => {
                         let _ = writeln!(w, "fix f_{name} {name} setforce 0.0 NULL 0.0");
                         load_row(w, wall, grains, p, force)?;
-                        wall_vars.push((name, format!("f_f_{name}[1]"), format!("f_l_{name}[2]"), a));
                     }
                 }
+                // The grains' force on the row: what `setforce` found before it set the
+                // row's (defined before `aveforce`, it sees the contacts' sum alone), a fix
+                // every control keeps, so one recording serves a protocol's stages.
+                wall_vars.push((name, format!("f_f_{name}[1]"), format!("f_f_{name}[2]"), a));
                 let _ = writeln!(w, "fix i_{name} {name} nve");
             }
         }
@@ -110,7 +112,11 @@ pub(crate) fn deck(scene: &Scene, ex: &Exported) -> Result<String, Error> {
     let record = if ex.bench { Analysis::None } else { info.analysis };
     if !scene.stages.is_empty() {
         // A protocol: one block per stage, the wall fixes changed between them.
-        stages(w, scene, ex, record, &mut wall_vars)?;
+        let mut header = String::new();
+        stages(w, &mut header, scene, ex, record, &wall_vars)?;
+        // Its Differs lines go with the others, before the first command.
+        let at = s.find("atom_style").expect("the deck's first command");
+        s.insert_str(at, &header);
         return Ok(s);
     }
     match record {
@@ -134,18 +140,24 @@ pub(crate) fn deck(scene: &Scene, ex: &Exported) -> Result<String, Error> {
     Ok(s)
 }
 
-/// The wall series' recording: the wall forces and the gap averaged over every `k`
-/// steps (`wall_vars`: each wall's name, x and y force, first atom), printed to walls.txt
-/// with `file_args`.
+/// The wall series' recording: the wall forces averaged over every `k` steps and the gap
+/// at the row's step (as grainlab's rows: forces averaged over the interval, the gap where
+/// the walls are at its end), printed to walls.txt with `file_args`. `k = 1` prints every
+/// step's forces as they are (a protocol's raw series, averaged by the digest).
 fn record_walls(w: &mut String, k: u64, wall_vars: &[WallVars], file_args: &str) {
     let (bot, top) = (&wall_vars[0], &wall_vars[1]);
     let _ = writeln!(w, "variable gap equal y[{}]-y[{}]", top.3, bot.3);
-    let _ = writeln!(w, "fix avg all ave/time 1 {k} {k} {} {} {} {} v_gap", bot.1, bot.2, top.1, top.2);
-    let mut cols = vec!["${s}".to_string()];
-    for j in 1..=5 {
-        let _ = writeln!(w, "variable a{j} equal f_avg[{j}]");
-        cols.push(format!("${{a{j}}}"));
+    let forces = [&bot.1, &bot.2, &top.1, &top.2];
+    if k > 1 {
+        let _ = writeln!(w, "fix avg all ave/time 1 {k} {k} {}", forces.iter().map(|s| s.as_str()).collect::<Vec<_>>().join(" "));
     }
+    let mut cols = vec!["${s}".to_string()];
+    for (j, force) in forces.iter().enumerate() {
+        let value = if k > 1 { format!("f_avg[{}]", j + 1) } else { force.to_string() };
+        let _ = writeln!(w, "variable a{} equal {value}", j + 1);
+        cols.push(format!("${{a{}}}", j + 1));
+    }
+    cols.push("${gap}".into());
     let _ = writeln!(w, "fix rec all print {k} \"{}\" {file_args}", cols.join(" "));
 }
 
@@ -153,22 +165,30 @@ fn record_walls(w: &mut String, k: u64, wall_vars: &[WallVars], file_args: &str)
 /// first atom's id.
 type WallVars = (&'static str, String, String, usize);
 
-/// A protocol's stages, each a `run` block. At each stage's start the step counter is
-/// reset (`reset_timestep 0`), so that the averages of the wall series, re-created with
-/// the stage's sampling, start with the stage, as grainlab's rows do; the printed step is
-/// the run's (`step` plus the steps before). A rough row's velocity is set with
-/// `velocity ... set` (a held row keeps it under `setforce 0 0 0` and nve), a change of
-/// its control replaces its `setforce`/`aveforce` fixes. What a flat wall would need
-/// (its motion and history live in its wall/gran fix) and gravity are refused by name.
-fn stages(w: &mut String, scene: &Scene, ex: &Exported, record: Analysis, wall_vars: &mut [WallVars]) -> Result<(), Error> {
+/// A protocol's stages, each a `run` block, and one recording for all of them: every
+/// step's wall forces and gap (walls.txt holds every step; the digest averages it into
+/// grainlab's rows of each stage). A rough row's velocity is set with `velocity ... set`
+/// (a held row keeps it under `setforce` and nve). A stage whose start changes only
+/// velocities runs with `pre no`: LIGGGHTS skips the run's setup, which would recompute
+/// the forces at the step-end velocities (with the new wall velocities) and rebuild the
+/// neighbour list, so its first half kick uses the last step's forces, as grainlab's does.
+/// A change of a wall's control replaces its `setforce`/`aveforce` fixes, which needs the
+/// setup: that stage's first step then differs, and the deck says so (a `# Differs:` line
+/// at its top, `header`). What a flat wall would need (its motion and history live in its
+/// wall/gran fix) and gravity are refused by name.
+fn stages(w: &mut String, header: &mut String, scene: &Scene, ex: &Exported, record: Analysis, wall_vars: &[WallVars]) -> Result<(), Error> {
     let e = ex.built.engine.as_ref();
     let p = e.particles();
     let info = &ex.info;
     let phases = crate::study::protocol::phases(scene, info.time_step_s, info.length_m, info.depth_m)?;
     let mut control: Vec<Control> = e.walls().iter().map(|wall| wall.control).collect();
+    if record == Analysis::Shear {
+        record_walls(w, 1, wall_vars, &format!("file walls.txt screen no title \"{}\"", info.columns.join(" ")));
+    }
     // (A stage's gravity and a protocol beside a flat wall were refused in `prepare`.)
     for (k, ph) in phases.iter().enumerate() {
         let _ = writeln!(w, "# stage {}: {} ({} steps from step {})", k + 1, comment(&ph.name), ph.steps, ph.first);
+        let mut setup = k == 0;
         for (i, wall) in e.walls().iter().enumerate() {
             let change = &ph.change.walls[i];
             if *change == WallMotion::default() {
@@ -176,21 +196,28 @@ fn stages(w: &mut String, scene: &Scene, ex: &Exported, record: Analysis, wall_v
             }
             let name = wall.name;
             let Surface::Rough { grains } = &wall.surface else { unreachable!("prepare refuses a protocol beside a flat wall") };
-            match (control[i], change.control) {
+            let before = control[i];
+            match (before, change.control) {
                 (_, None) | (Control::Fixed, Some(Control::Fixed)) => {}
-                (before, Some(Control::Load { force })) => {
+                (_, Some(Control::Load { force })) => {
                     if before == Control::Fixed {
                         let _ = writeln!(w, "unfix f_{name}\nfix f_{name} {name} setforce 0.0 NULL 0.0");
                     } else {
                         let _ = writeln!(w, "unfix l_{name}");
                     }
                     load_row(w, wall, grains, p, force)?;
-                    wall_vars[i].2 = format!("f_l_{name}[2]");
                 }
                 (Control::Load { .. }, Some(Control::Fixed)) => {
                     let _ = writeln!(w, "unfix l_{name}\nunfix f_{name}\nfix f_{name} {name} setforce 0.0 0.0 0.0");
-                    wall_vars[i].2 = format!("f_f_{name}[2]");
                 }
+            }
+            if k > 0 && change.control.is_some_and(|c| c != before || matches!(c, Control::Load { .. })) {
+                setup = true;
+                let value = match change.control {
+                    Some(Control::Load { force }) => format!("a load of {} N", f(force)),
+                    _ => "\"fixed\"".into(),
+                };
+                let _ = writeln!(header, "{}", differs_line(Code::Liggghts, &format!("stages[{k}].walls.{name}.control"), value));
             }
             control[i] = change.control.unwrap_or(control[i]);
             // The y velocity as resolved for the stage (0 for a wall changed to fixed).
@@ -200,16 +227,8 @@ fn stages(w: &mut String, scene: &Scene, ex: &Exported, record: Analysis, wall_v
                 let _ = writeln!(w, "velocity {name} set {} {} NULL units box", v(vx), v(vy));
             }
         }
-        let _ = writeln!(w, "reset_timestep 0\nvariable s equal step+{}", ph.first);
-        if record == Analysis::Shear {
-            if k > 0 {
-                let _ = writeln!(w, "unfix rec\nunfix avg");
-            }
-            let file = if k == 0 { format!("file walls.txt screen no title \"{}\"", info.columns.join(" ")) } else { format!("append walls.txt screen no title \"# stage {}\"", comment(&ph.name)) };
-            record_walls(w, ph.sample_every, wall_vars, &file);
-        }
         let _ = writeln!(w, "thermo_style custom step atoms\nthermo {}", (ph.steps / 10).max(1));
-        let _ = writeln!(w, "run {}", ph.steps);
+        let _ = writeln!(w, "run {}{}", ph.steps, if setup { "" } else { " pre no post no" });
     }
     Ok(())
 }

@@ -86,7 +86,7 @@ pub(crate) fn prepare(scene: &Scene, code: Code, limits: &crate::scene::limits::
         length_m: built.length,
         depth_m: built.depth,
         columns,
-        stages: phases.iter().filter(|p| !p.name.is_empty()).map(|p| ExportStage { name: p.name.clone(), first_step: p.first, steps: p.steps, average: p.average }).collect(),
+        stages: phases.iter().filter(|p| !p.name.is_empty()).map(|p| ExportStage { name: p.name.clone(), first_step: p.first, steps: p.steps, sample_every: p.sample_every, average: p.average }).collect(),
         statistics: scene.statistics,
     };
     Ok(Exported { built, info, bench: false })

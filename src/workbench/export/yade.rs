@@ -113,7 +113,11 @@ pub(crate) fn deck(scene: &Scene, ex: &Exported) -> Result<String, Error> {
         let _ = writeln!(w, "X0 = {}\nL = {}\nH = {}", f(b.x_min), f(b.period), f(10.0 * (hi - lo)));
         let _ = writeln!(w, "FREE = {}\nBOTTOM = ({b0}, {b1})\nTOP = ({t0}, {t1})", p.n_free);
         let _ = writeln!(w, "LOAD = {}  # N on the top wall, towards the grains (0: the wall is held)", f(load));
-        let _ = writeln!(w, "SAMPLE = {}  # steps per row of walls.txt (forces averaged over each step)", info.sample_every);
+        if scene.stages.is_empty() {
+            let _ = writeln!(w, "SAMPLE = {}  # steps per row of walls.txt (forces averaged over each step)", info.sample_every);
+        } else {
+            let _ = writeln!(w, "SAMPLE = 1  # a protocol's walls.txt: a row at every step");
+        }
         let _ = writeln!(w, "{}", SHEAR_FREE);
         if !no_spin.is_empty() {
             let _ = writeln!(w, "{no_spin}");
@@ -186,10 +190,17 @@ O.engines = [
 ]
 O.dt = DT"#;
 
-/// A protocol's run: the rows averaged over each stage's own sampling from its start
-/// (`FIRST`; the sums restart with each stage, as grainlab's rows do), and at each
-/// stage's start the rows' velocities, the top clump's control (blocked in y and held,
-/// or free in y under a permanent load) set as the stage says.
+/// A protocol's run: a row at every step (walls.txt holds every step; the digest averages
+/// it into grainlab's rows of each stage, `export.json` stages), and the stages' changes
+/// (the rows' velocities, the top clump's control: blocked in y and held, or free in y
+/// under a permanent load). The first stage's are made before the run; each later one's in
+/// the recording PyRunner of the iteration at the stage's first step, after the forces of
+/// that state are recorded and before NewtonIntegrator moves the bodies: as in grainlab,
+/// where the last step of a stage ends with its forces and the next stage's first half
+/// kick and drift see the new velocities. (Changed before an `O.run` instead, the walls'
+/// new velocities would enter the contact forces of the stage's first state, one step
+/// early.) The run goes one iteration past the protocol: its PyRunner records the forces
+/// of the last step's state.
 fn stages(scene: &Scene, ex: &Exported) -> Result<String, Error> {
     let info = &ex.info;
     let phases = crate::study::protocol::phases(scene, info.time_step_s, info.length_m, info.depth_m)?;
@@ -203,29 +214,26 @@ fn stages(scene: &Scene, ex: &Exported) -> Result<String, Error> {
             Some(Control::Fixed) => "0.0".into(),
             None => "None".into(),
         };
-        rows.push(format!(
-            "    ({:?}, {}, {}, {}, {}, {}, {}, {}, {load}),",
-            ph.name,
-            ph.first,
-            ph.steps,
-            ph.sample_every,
-            py(b.velocity_x),
-            py(b.velocity_y),
-            py(t.velocity_x),
-            py(t.velocity_y)
-        ));
+        rows.push(format!("    ({:?}, {}, {}, {}, {}, {}, {}, {load}),", ph.name, ph.first, ph.steps, py(b.velocity_x), py(b.velocity_y), py(t.velocity_x), py(t.velocity_y)));
     }
-    let run = SHEAR_RUN.replace("    if O.iter % SAMPLE == 0:", "    if (O.iter - FIRST) % SAMPLE == 0:").replace(
-        "O.run(STEPS, True)\n",
-        &format!("# name, first step, steps, sample, bottom vx, vy, top vx, vy (None: unchanged), top load (N; 0 held, None unchanged)\nSTAGES = [\n{}\n]\n{STAGE_LOOP}\n", rows.join("\n")),
-    );
-    Ok(format!("FIRST = 0\n{run}"))
+    let total = phases.last().map_or(0, |p| p.last());
+    let run = SHEAR_RUN
+        .replace("        for k in range(4):\n            acc[k] = 0.0\n", "        for k in range(4):\n            acc[k] = 0.0\n    while NEXT[0] < len(STAGES) and STAGES[NEXT[0]][1] == O.iter:\n        begin(STAGES[NEXT[0]])\n")
+        .replace(
+            "O.run(STEPS, True)\n",
+            &format!(
+                "# name, first step, steps, bottom vx, vy, top vx, vy (None: unchanged), top load (N; 0 held, None unchanged)\nSTAGES = [\n{}\n]\n{STAGE_BEGIN}\nbegin(STAGES[0])\nO.run({} + 1, True)\n",
+                rows.join("\n"),
+                total
+            ),
+        );
+    Ok(format!("NEXT = [0]  # the next stage to begin\n{run}"))
 }
 
-const STAGE_LOOP: &str = r#"for name, first, steps, sample, bvx, bvy, tvx, tvy, load in STAGES:
-    FIRST, SAMPLE = first, sample
-    for k in range(5):
-        acc[k] = 0.0
+const STAGE_BEGIN: &str = r#"def begin(stage):
+    global LOAD
+    name, first, steps, bvx, bvy, tvx, tvy, load = stage
+    NEXT[0] += 1
     for i in bottom:
         v = O.bodies[i].state.vel
         O.bodies[i].state.vel = Vector3(v[0] if bvx is None else bvx, v[1] if bvy is None else bvy, 0)
@@ -233,8 +241,7 @@ const STAGE_LOOP: &str = r#"for name, first, steps, sample, bvx, bvy, tvx, tvy, 
         LOAD = load
         c.blockedDOFs = 'xzXYZ' if LOAD > 0 else 'xyzXYZ'
         O.forces.setPermF(top_clump, Vector3(0, -LOAD, 0))
-    c.vel = Vector3(c.vel[0] if tvx is None else tvx, c.vel[1] if tvy is None else tvy, 0)
-    O.run(steps, True)"#;
+    c.vel = Vector3(c.vel[0] if tvx is None else tvx, c.vel[1] if tvy is None else tvy, 0)"#;
 
 const IMPACT_SETUP: &str = r#"ids = [O.bodies.append(b) for b in grains()]"#;
 
@@ -264,7 +271,7 @@ if LOAD > 0:
 
 const SHEAR_RUN: &str = r#"out = open('walls.txt', 'w')
 out.write('step bottom_fx_n bottom_fy_n top_fx_n top_fy_n gap_m\n')
-acc = [0.0] * 5
+acc = [0.0] * 4
 def record():
     fb = Vector3(0, 0, 0)
     for i in bottom:
@@ -272,12 +279,12 @@ def record():
     ft = Vector3(0, 0, 0)
     for i in top:
         ft += O.forces.f(i, sync=True)
-    gap = O.bodies[top[0]].state.pos[1] - O.bodies[bottom[0]].state.pos[1]
-    for k, v in enumerate((fb[0], fb[1], ft[0], ft[1], gap)):
+    for k, v in enumerate((fb[0], fb[1], ft[0], ft[1])):
         acc[k] += v
     if O.iter % SAMPLE == 0:
-        out.write('%d %s\n' % (O.iter, ' '.join('%.17g' % (a / SAMPLE) for a in acc)))
-        for k in range(5):
+        gap = O.bodies[top[0]].state.pos[1] - O.bodies[bottom[0]].state.pos[1]
+        out.write('%d %s %.17g\n' % (O.iter, ' '.join('%.17g' % (a / SAMPLE) for a in acc), gap))
+        for k in range(4):
             acc[k] = 0.0
 import time
 t0 = time.time()

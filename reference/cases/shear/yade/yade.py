@@ -68,7 +68,7 @@ if LOAD > 0:
     O.forces.setPermF(top_clump, Vector3(0, -LOAD, 0))
 out = open('walls.txt', 'w')
 out.write('step bottom_fx_n bottom_fy_n top_fx_n top_fy_n gap_m\n')
-acc = [0.0] * 5
+acc = [0.0] * 4
 def record():
     fb = Vector3(0, 0, 0)
     for i in bottom:
@@ -76,12 +76,12 @@ def record():
     ft = Vector3(0, 0, 0)
     for i in top:
         ft += O.forces.f(i, sync=True)
-    gap = O.bodies[top[0]].state.pos[1] - O.bodies[bottom[0]].state.pos[1]
-    for k, v in enumerate((fb[0], fb[1], ft[0], ft[1], gap)):
+    for k, v in enumerate((fb[0], fb[1], ft[0], ft[1])):
         acc[k] += v
     if O.iter % SAMPLE == 0:
-        out.write('%d %s\n' % (O.iter, ' '.join('%.17g' % (a / SAMPLE) for a in acc)))
-        for k in range(5):
+        gap = O.bodies[top[0]].state.pos[1] - O.bodies[bottom[0]].state.pos[1]
+        out.write('%d %s %.17g\n' % (O.iter, ' '.join('%.17g' % (a / SAMPLE) for a in acc), gap))
+        for k in range(4):
             acc[k] = 0.0
 import time
 t0 = time.time()
