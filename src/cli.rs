@@ -395,14 +395,7 @@ fn execute(cli: Cli) -> Result<(), Error> {
 }
 
 fn compare(root: &std::path::Path, filter: Option<&str>, csv: Option<&std::path::Path>) -> Result<(), Error> {
-    use grainlab::workbench::{case_dirs, compare_case};
-    let mut rows = Vec::new();
-    for dir in case_dirs(root) {
-        if filter.is_some_and(|f| !dir.to_string_lossy().contains(f)) {
-            continue;
-        }
-        rows.extend(compare_case(&dir)?);
-    }
+    let rows = grainlab::workbench::compare_all(root, filter)?;
     say!("{:<40} {:<9} {:<32} {:>14} {:>14} {:>10} {:>9} pass", "case", "code", "quantity", "engine", "reference", "diff", "bound")?;
     for r in &rows {
         let (d, kind) = (r.diff(), if r.relative { "rel" } else { "abs" });

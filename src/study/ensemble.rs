@@ -139,6 +139,20 @@ pub fn ensemble(scene: &Scene, seeds: &[u64], duration: Option<f64>, threads: us
     })
 }
 
+/// The ensemble statistics of values without block intervals (one per run); none for
+/// fewer than two values or a value that is not finite.
+pub fn ensemble_stat(values: &[f64]) -> Option<EnsembleStat> {
+    stat(&values.iter().map(|&x| (x, None)).collect::<Vec<_>>())
+}
+
+impl EnsembleStat {
+    /// The ensemble mean as an estimate whose interval is the run-to-run one: its
+    /// standard error std / sqrt(runs) and runs - 1 degrees of freedom (`blocks` = runs).
+    pub fn as_estimate(&self) -> Estimate {
+        Estimate { mean: self.mean, ci95: self.ci95, blocks: self.runs, autocorrelation_time_s: None }
+    }
+}
+
 /// The ensemble statistics of the runs' values (each with its block half-width and
 /// standard error, if any); none for fewer than two values or a value that is not finite.
 fn stat(values: &[(f64, Option<(f64, f64)>)]) -> Option<EnsembleStat> {

@@ -31,6 +31,12 @@ pub struct CaseInfo {
     pub quick: bool,
     /// Keep the force-overlap curve.
     pub curve: bool,
+    /// The ensemble this case is a member of (its folder under reference/cases): the
+    /// members differ only by their packing's seed and are compared together, the mean
+    /// over the members on each side with an interval from the seed-to-seed spread
+    /// ([`crate::workbench::compare_ensemble`]), not one by one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ensemble: Option<String>,
 }
 
 #[derive(Clone, Debug)]
@@ -63,7 +69,7 @@ pub fn cases() -> Vec<Case> {
                     s.description = format!("head-on glass beads r = 1 mm, e = {e}, v = {v} m/s, dt = t_c/{n}, Fn clamp {}", if clamp { "on" } else { "off" });
                     let codes = if clamp { vec![Code::Liggghts, Code::Yade] } else { vec![Code::Liggghts] };
                     let curve = n == 500.0 && v == 1.0 && [0.1, 0.5, 0.9].contains(&e);
-                    out.push(Case { info: CaseInfo { name, description: s.description.clone(), codes, quick: v == 1.0, curve }, scene: s });
+                    out.push(Case { info: CaseInfo { name, description: s.description.clone(), codes, quick: v == 1.0, curve, ensemble: None }, scene: s });
                 }
             }
         }
@@ -75,7 +81,7 @@ pub fn cases() -> Vec<Case> {
                 let tag = if code == Code::Liggghts { "history" } else { "incremental" };
                 let name = format!("oblique-{target}/{tag}-a{}", num(a));
                 s.name = name.replace('/', "-");
-                out.push(Case { info: CaseInfo { name, description: s.description.clone(), codes: vec![code], quick: a == 45.0, curve: false }, scene: s });
+                out.push(Case { info: CaseInfo { name, description: s.description.clone(), codes: vec![code], quick: a == 45.0, curve: false, ensemble: None }, scene: s });
             }
         }
     }
@@ -84,23 +90,48 @@ pub fn cases() -> Vec<Case> {
     s.name = "shear-liggghts".into();
     s.description = "the shear cell (built-in `shear`) with LIGGGHTS' lever arm".into();
     s.output.frames = 0;
-    out.push(Case { info: CaseInfo { name: "shear/liggghts".into(), description: s.description.clone(), codes: vec![Code::Liggghts], quick: false, curve: false }, scene: s });
+    out.push(Case { info: CaseInfo { name: "shear/liggghts".into(), description: s.description.clone(), codes: vec![Code::Liggghts], quick: false, curve: false, ensemble: None }, scene: s });
     let mut s = builtin::shear();
     matched(&mut s, TangentialSpec::IncrementalForce);
     s.name = "shear-yade".into();
     s.description = "the shear cell (built-in `shear`) with YADE's incremental tangential force, kinematics and clamp".into();
     s.output.frames = 0;
-    out.push(Case { info: CaseInfo { name: "shear/yade".into(), description: s.description.clone(), codes: vec![Code::Yade], quick: false, curve: false }, scene: s });
+    out.push(Case { info: CaseInfo { name: "shear/yade".into(), description: s.description.clone(), codes: vec![Code::Yade], quick: false, curve: false, ensemble: None }, scene: s });
     let s = protocol_case();
-    out.push(Case { info: CaseInfo { name: "protocol/liggghts".into(), description: s.description.clone(), codes: vec![Code::Liggghts], quick: true, curve: false }, scene: s });
+    out.push(Case { info: CaseInfo { name: "protocol/liggghts".into(), description: s.description.clone(), codes: vec![Code::Liggghts], quick: true, curve: false, ensemble: None }, scene: s });
     let mut s = builtin::protocol();
     s.model.lever_arm = LeverArm::RadiusMinusHalfOverlap;
     s.name = "protocol-builtin-liggghts".into();
     s.description = "the built-in protocol (compress to 100 kPa, relax, shear at +-0.5 m/s, then at +-2 m/s; 1000 grains) with LIGGGHTS' lever arm: its last stage's averages".into();
     s.output.frames = 0;
-    out.push(Case { info: CaseInfo { name: "protocol/builtin".into(), description: s.description.clone(), codes: vec![Code::Liggghts], quick: false, curve: false }, scene: s });
+    out.push(Case { info: CaseInfo { name: "protocol/builtin".into(), description: s.description.clone(), codes: vec![Code::Liggghts], quick: false, curve: false, ensemble: None }, scene: s });
+    // The shear cell's ensembles: 200 grains (a fifth of the built-in cell, same height)
+    // over ENSEMBLE_SEEDS packings, each code with its own formulation, as the single
+    // runs above.
+    for (code, tag) in [(Code::Liggghts, "liggghts"), (Code::Yade, "yade")] {
+        let group = format!("shear-ensemble/{tag}");
+        for seed in ENSEMBLE_SEEDS {
+            let mut s = builtin::shear_cell(200, 0.008);
+            if let crate::scene::Grains::Pack(p) = &mut s.grains {
+                p.seed = seed;
+            }
+            if code == Code::Liggghts {
+                s.model.lever_arm = LeverArm::RadiusMinusHalfOverlap;
+            } else {
+                matched(&mut s, TangentialSpec::IncrementalForce);
+            }
+            s.output.frames = 0;
+            let name = format!("{group}/seed-{seed}");
+            s.name = name.replace('/', "-");
+            s.description = format!("the shear cell with 200 grains (0.008 m periodic), packing seed {seed}, with {}'s settings: one member of {group}", code.name());
+            out.push(Case { info: CaseInfo { name, description: s.description.clone(), codes: vec![code], quick: false, curve: false, ensemble: Some(group.clone()) }, scene: s });
+        }
+    }
     out
 }
+
+/// The packing seeds of the workbench's shear ensembles.
+pub const ENSEMBLE_SEEDS: std::ops::RangeInclusive<u64> = 1..=8;
 
 /// The workbench's protocol: a 200-grain shear cell, with LIGGGHTS' lever arm, under
 /// 100 kPa, packed loosely (area fraction 0.6, so no two grains touch at the start). The

@@ -158,8 +158,11 @@ pub fn welch_p(a: &crate::observe::stats::Estimate, b: &crate::observe::stats::E
 /// Run the engine on a committed case and compare it with every code that has data.
 pub fn compare_case(case_dir: &Path) -> Result<Vec<Row>, Error> {
     let (case, info) = read_info(case_dir)?;
-    let text = std::fs::read_to_string(case_dir.join("scene.json")).map_err(|e| Error::io(case_dir.join("scene.json").display(), e))?;
-    let scene = Scene::from_json(&text)?;
+    if case.ensemble.is_some() {
+        // Compared with its ensemble's other members: compare_ensemble.
+        return Ok(Vec::new());
+    }
+    let scene = read_scene(case_dir)?;
     let mut rows = Vec::new();
     let codes: Vec<Code> = case.codes.iter().copied().filter(|c| case_dir.join("expected").join(c.name()).exists()).collect();
     if codes.is_empty() {
@@ -206,6 +209,119 @@ pub fn compare_case(case_dir: &Path) -> Result<Vec<Row>, Error> {
             }
         }
         Analysis::None => {}
+    }
+    Ok(rows)
+}
+
+fn read_scene(case_dir: &Path) -> Result<Scene, Error> {
+    let text = std::fs::read_to_string(case_dir.join("scene.json")).map_err(|e| Error::io(case_dir.join("scene.json").display(), e))?;
+    Scene::from_json(&text)
+}
+
+/// Every comparison under `root` (cases whose folder contains `filter`, if given): each
+/// case on its own ([`compare_case`]), then each ensemble with all its members
+/// ([`compare_ensemble`]).
+pub fn compare_all(root: &Path, filter: Option<&str>) -> Result<Vec<Row>, Error> {
+    let mut rows = Vec::new();
+    let mut ensembles: std::collections::BTreeMap<String, Vec<std::path::PathBuf>> = Default::default();
+    for dir in crate::workbench::case_dirs(root) {
+        if filter.is_some_and(|f| !dir.to_string_lossy().contains(f)) {
+            continue;
+        }
+        let (case, _) = read_info(&dir)?;
+        match case.ensemble {
+            Some(group) => ensembles.entry(group).or_default().push(dir),
+            None => rows.extend(compare_case(&dir)?),
+        }
+    }
+    for (group, members) in ensembles {
+        rows.extend(compare_ensemble(&group, &members)?);
+    }
+    Ok(rows)
+}
+
+/// Compare an ensemble (`members`: case folders that differ by their packing's seed):
+/// the engine runs every member's scene, and each side's tau, sigma and tau/sigma are the
+/// mean over the members of their time averages, with a 95% interval from the
+/// member-to-member spread (Student t, members - 1 degrees of freedom). The means must
+/// differ by less than the combined interval sqrt(ci_engine^2 + ci_reference^2), and
+/// Welch's test on tau/sigma must not reject equal means at 5%: the comparison of
+/// [`compare_shear`] with the run-to-run interval in place of a run's block interval,
+/// which understates what another packing gives (docs/statistics.md). Members without
+/// the code's data are left out on both sides.
+pub fn compare_ensemble(group: &str, members: &[std::path::PathBuf]) -> Result<Vec<Row>, Error> {
+    use crate::study::ensemble::ensemble_stat;
+    // The members with data, then their engine runs, as many at once as the machine has
+    // cores (each run on one thread, so the results do not depend on how many run at once).
+    let mut todo = Vec::new();
+    for dir in members {
+        let (case, _) = read_info(dir)?;
+        let codes: Vec<Code> = case.codes.iter().copied().filter(|c| dir.join("expected").join(c.name()).exists()).collect();
+        if !codes.is_empty() {
+            todo.push((dir, case.name, read_scene(dir)?, codes));
+        }
+    }
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let workers = std::thread::available_parallelism().map_or(1, |n| n.get()).min(todo.len()).max(1);
+    let mut engine: Vec<Option<Result<ShearSummary, Error>>> = (0..todo.len()).map(|_| None).collect();
+    std::thread::scope(|scope| {
+        let handles: Vec<_> = (0..workers)
+            .map(|_| {
+                scope.spawn(|| {
+                    let mut done = Vec::new();
+                    loop {
+                        let k = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                        let Some((_, name, scene, _)) = todo.get(k) else { break };
+                        let run = run_scene(scene, &RunOptions::default()).and_then(|s| s.shear.ok_or_else(|| Error::Other(format!("{name}: no shear summary"))));
+                        done.push((k, run));
+                    }
+                    done
+                })
+            })
+            .collect();
+        for h in handles {
+            for (k, run) in h.join().expect("an ensemble member's run panicked") {
+                engine[k] = Some(run);
+            }
+        }
+    });
+    let mut by_code: std::collections::BTreeMap<Code, (Vec<ShearSummary>, Vec<ShearSummary>)> = Default::default();
+    for ((dir, _, _, codes), run) in todo.iter().zip(engine) {
+        let run = run.expect("every member ran")?;
+        for &code in codes {
+            let e = by_code.entry(code).or_default();
+            e.0.push(run.clone());
+            e.1.push(expected_shear(dir, code)?);
+        }
+    }
+    let mut rows = Vec::new();
+    for (code, (engine, reference)) in by_code {
+        let n = engine.len();
+        let of = |runs: &[ShearSummary], q: fn(&ShearSummary) -> Option<f64>| -> Result<crate::observe::stats::Estimate, Error> {
+            let values: Vec<f64> = runs.iter().filter_map(q).collect();
+            if values.len() != n {
+                return Err(Error::Other(format!("{group}: a member without the quantity (tau/sigma needs a normal stress)")));
+            }
+            ensemble_stat(&values).map(|s| s.as_estimate()).ok_or_else(|| Error::Other(format!("{group}: fewer than two members with data")))
+        };
+        let quantities: [(&str, fn(&ShearSummary) -> Option<f64>); 3] = [
+            ("shear_stress_pa", |s| Some(s.shear_stress_pa.mean)),
+            ("normal_stress_pa", |s| Some(s.normal_stress_pa.mean)),
+            ("stress_ratio", |s| s.stress_ratio.map(|r| r.mean)),
+        ];
+        let mut ratio = None;
+        for (q, get) in quantities {
+            let (a, b) = (of(&engine, get)?, of(&reference, get)?);
+            rows.push(Row::new(group, code, &format!("{q}_mean_of_{n}"), a.mean, b.mean, (a.ci95 * a.ci95 + b.ci95 * b.ci95).sqrt(), false));
+            if q == "stress_ratio" {
+                ratio = Some((a, b));
+            }
+        }
+        let (a, b) = ratio.expect("tau/sigma compared");
+        let p = welch_p(&a, &b);
+        let mut r = Row::new(group, code, &format!("stress_ratio_mean_of_{n}_welch_p_value"), p, 1.0, 0.95, false);
+        r.pass = p >= 0.05;
+        rows.push(r);
     }
     Ok(rows)
 }
