@@ -224,7 +224,7 @@ fn read_scene(case_dir: &Path) -> Result<Scene, Error> {
 pub fn compare_all(root: &Path, filter: Option<&str>) -> Result<Vec<Row>, Error> {
     let mut rows = Vec::new();
     let mut ensembles: std::collections::BTreeMap<String, Vec<std::path::PathBuf>> = Default::default();
-    for dir in crate::workbench::case_dirs(root) {
+    for dir in crate::workbench::cases::case_dirs(root) {
         if filter.is_some_and(|f| !dir.to_string_lossy().contains(f)) {
             continue;
         }
