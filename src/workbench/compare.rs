@@ -8,6 +8,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::Error;
 use crate::observe::impact::{CurvePoint, ImpactSummary};
+use crate::observe::stats::Estimate;
 use crate::observe::stress::{ShearSummary, WallRow};
 use crate::scene::{Analysis, Scene};
 use crate::study::run::{RunOptions, run_scene};
@@ -121,19 +122,27 @@ pub fn compare_impact(case: &str, code: Code, engine: &ImpactSummary, reference:
 /// interval `sqrt(ci_a^2 + ci_b^2)` (a Welch-type bound on two independent estimates).
 pub fn compare_shear(case: &str, code: Code, engine: &ShearSummary, reference: &ShearSummary) -> Vec<Row> {
     // tau/sigma is undefined without a normal stress: then it cannot agree.
-    let undefined = crate::observe::stats::Estimate { mean: f64::NAN, ci95: f64::NAN, blocks: 0, autocorrelation_time_s: None };
-    let (ratio_a, ratio_b) = (engine.stress_ratio.unwrap_or(undefined), reference.stress_ratio.unwrap_or(undefined));
-    let pairs = [
-        ("shear_stress_pa", engine.shear_stress_pa, reference.shear_stress_pa),
-        ("normal_stress_pa", engine.normal_stress_pa, reference.normal_stress_pa),
-        ("stress_ratio", ratio_a, ratio_b),
-    ];
-    let mut rows: Vec<Row> = pairs.iter().map(|(q, a, b)| Row::new(case, code, q, a.mean, b.mean, (a.ci95 * a.ci95 + b.ci95 * b.ci95).sqrt(), false)).collect();
-    // Welch's t test on tau/sigma: the two block-average estimates have equal means unless
-    // p < 0.05. The row carries p as its "difference" from 1 so that the same pass rule
-    // (difference <= bound) reads p >= 0.05.
-    let p = welch_p(&ratio_a, &ratio_b);
-    let mut r = Row::new(case, code, "stress_ratio_welch_p_value", p, 1.0, 0.95, false);
+    let undefined = Estimate { mean: f64::NAN, ci95: f64::NAN, blocks: 0, autocorrelation_time_s: None };
+    let of = |s: &ShearSummary| [s.shear_stress_pa, s.normal_stress_pa, s.stress_ratio.unwrap_or(undefined)];
+    compare_stresses(case, code, "", of(engine), of(reference))
+}
+
+/// The shear comparison's rows of tau, sigma and tau/sigma (`engine` and `reference` in
+/// that order, each quantity named with `suffix`): each mean within the combined 95%
+/// interval, and Welch's t test on tau/sigma.
+fn compare_stresses(case: &str, code: Code, suffix: &str, engine: [Estimate; 3], reference: [Estimate; 3]) -> Vec<Row> {
+    let names = ["shear_stress_pa", "normal_stress_pa", "stress_ratio"];
+    let mut rows: Vec<Row> = (0..3)
+        .map(|k| {
+            let (a, b) = (&engine[k], &reference[k]);
+            Row::new(case, code, &format!("{}{suffix}", names[k]), a.mean, b.mean, (a.ci95 * a.ci95 + b.ci95 * b.ci95).sqrt(), false)
+        })
+        .collect();
+    // Welch's t test on tau/sigma: the two estimates have equal means unless p < 0.05. The
+    // row carries p as its "difference" from 1 so that the same pass rule (difference <=
+    // bound) reads p >= 0.05.
+    let p = welch_p(&engine[2], &reference[2]);
+    let mut r = Row::new(case, code, &format!("stress_ratio{suffix}_welch_p_value"), p, 1.0, 0.95, false);
     r.pass = p >= 0.05;
     rows.push(r);
     rows
@@ -141,7 +150,7 @@ pub fn compare_shear(case: &str, code: Code, engine: &ShearSummary, reference: &
 
 /// Two-sided p-value of Welch's t test for two block-average estimates (mean, 95% half
 /// width, number of blocks), with the Welch-Satterthwaite degrees of freedom (statrs).
-pub fn welch_p(a: &crate::observe::stats::Estimate, b: &crate::observe::stats::Estimate) -> f64 {
+pub fn welch_p(a: &Estimate, b: &Estimate) -> f64 {
     use statrs::distribution::{ContinuousCDF, StudentsT};
     let (sa, sb) = (a.standard_error(), b.standard_error());
     let (va, vb) = (sa * sa, sb * sb);
@@ -164,7 +173,7 @@ pub fn compare_case(case_dir: &Path) -> Result<Vec<Row>, Error> {
     }
     let scene = read_scene(case_dir)?;
     let mut rows = Vec::new();
-    let codes: Vec<Code> = case.codes.iter().copied().filter(|c| case_dir.join("expected").join(c.name()).exists()).collect();
+    let codes = codes_with_data(&case, case_dir);
     if codes.is_empty() {
         return Ok(rows);
     }
@@ -213,6 +222,11 @@ pub fn compare_case(case_dir: &Path) -> Result<Vec<Row>, Error> {
     Ok(rows)
 }
 
+/// The codes of a case that have committed data (`expected/<code>/`).
+fn codes_with_data(case: &crate::workbench::cases::CaseInfo, case_dir: &Path) -> Vec<Code> {
+    case.codes.iter().copied().filter(|c| case_dir.join("expected").join(c.name()).exists()).collect()
+}
+
 fn read_scene(case_dir: &Path) -> Result<Scene, Error> {
     let text = std::fs::read_to_string(case_dir.join("scene.json")).map_err(|e| Error::io(case_dir.join("scene.json").display(), e))?;
     Scene::from_json(&text)
@@ -256,7 +270,7 @@ pub fn compare_ensemble(group: &str, members: &[std::path::PathBuf]) -> Result<V
     let mut todo = Vec::new();
     for dir in members {
         let (case, _) = read_info(dir)?;
-        let codes: Vec<Code> = case.codes.iter().copied().filter(|c| dir.join("expected").join(c.name()).exists()).collect();
+        let codes = codes_with_data(&case, dir);
         if !codes.is_empty() {
             todo.push((dir, case.name, read_scene(dir)?, codes));
         }
@@ -297,31 +311,20 @@ pub fn compare_ensemble(group: &str, members: &[std::path::PathBuf]) -> Result<V
     let mut rows = Vec::new();
     for (code, (engine, reference)) in by_code {
         let n = engine.len();
-        let of = |runs: &[ShearSummary], q: fn(&ShearSummary) -> Option<f64>| -> Result<crate::observe::stats::Estimate, Error> {
-            let values: Vec<f64> = runs.iter().filter_map(q).collect();
-            if values.len() != n {
-                return Err(Error::Other(format!("{group}: a member without the quantity (tau/sigma needs a normal stress)")));
+        // Each quantity's ensemble estimate over the members (all of them must have it).
+        let of = |runs: &[ShearSummary]| -> Result<[Estimate; 3], Error> {
+            let quantities: [fn(&ShearSummary) -> Option<f64>; 3] = [|s| Some(s.shear_stress_pa.mean), |s| Some(s.normal_stress_pa.mean), |s| s.stress_ratio.map(|r| r.mean)];
+            let mut out = Vec::with_capacity(3);
+            for q in quantities {
+                let values: Vec<f64> = runs.iter().filter_map(q).collect();
+                if values.len() != n {
+                    return Err(Error::Other(format!("{group}: a member without the quantity (tau/sigma needs a normal stress)")));
+                }
+                out.push(ensemble_stat(&values).map(|s| s.as_estimate()).ok_or_else(|| Error::Other(format!("{group}: fewer than two members with data")))?);
             }
-            ensemble_stat(&values).map(|s| s.as_estimate()).ok_or_else(|| Error::Other(format!("{group}: fewer than two members with data")))
+            Ok(out.try_into().expect("three quantities"))
         };
-        let quantities: [(&str, fn(&ShearSummary) -> Option<f64>); 3] = [
-            ("shear_stress_pa", |s| Some(s.shear_stress_pa.mean)),
-            ("normal_stress_pa", |s| Some(s.normal_stress_pa.mean)),
-            ("stress_ratio", |s| s.stress_ratio.map(|r| r.mean)),
-        ];
-        let mut ratio = None;
-        for (q, get) in quantities {
-            let (a, b) = (of(&engine, get)?, of(&reference, get)?);
-            rows.push(Row::new(group, code, &format!("{q}_mean_of_{n}"), a.mean, b.mean, (a.ci95 * a.ci95 + b.ci95 * b.ci95).sqrt(), false));
-            if q == "stress_ratio" {
-                ratio = Some((a, b));
-            }
-        }
-        let (a, b) = ratio.expect("tau/sigma compared");
-        let p = welch_p(&a, &b);
-        let mut r = Row::new(group, code, &format!("stress_ratio_mean_of_{n}_welch_p_value"), p, 1.0, 0.95, false);
-        r.pass = p >= 0.05;
-        rows.push(r);
+        rows.extend(compare_stresses(group, code, &format!("_mean_of_{n}"), of(&engine)?, of(&reference)?));
     }
     Ok(rows)
 }
@@ -351,7 +354,7 @@ pub fn compare_steps(case: &str, code: Code, info: &ExportInfo, load: Option<f64
         return Err(Error::Other(format!("{case}: the engine wrote {} rows, {} {}", engine.len(), code.name(), reference.len())));
     }
     let dt = info.time_step_s;
-    let in_stepped = |t: f64| info.stages.iter().any(|st| st.sample_every == 1 && t > st.first_step as f64 * dt && t <= (st.first_step + st.steps) as f64 * dt);
+    let in_stepped = |t: f64| info.stages.iter().any(|st| st.sample_every == 1 && st.holds(t, dt));
     let mut pairs = Vec::new();
     for (k, (a, b)) in engine.iter().zip(reference).enumerate() {
         if (a.time_s - b.time_s).abs() > 1e-9 * dt {

@@ -17,8 +17,7 @@ use crate::workbench::export::{Code, ExportInfo};
 /// Read a whitespace table with a header line (series.txt, walls.txt).
 fn read_table(path: &Path) -> Result<(Vec<String>, Vec<Vec<f64>>), Error> {
     let text = std::fs::read_to_string(path).map_err(|e| Error::io(path.display(), e))?;
-    // A protocol's deck marks each stage's rows with a `#` line.
-    let mut lines = text.lines().filter(|l| !l.trim().is_empty() && !l.starts_with('#'));
+    let mut lines = text.lines().filter(|l| !l.trim().is_empty());
     let header: Vec<String> = lines.next().ok_or_else(|| Error::Other(format!("{}: empty", path.display())))?.split_whitespace().map(String::from).collect();
     let mut rows = Vec::new();
     for (k, l) in lines.enumerate() {
@@ -65,11 +64,7 @@ pub fn digest(case_dir: &Path, code: Code, run_dir: &Path) -> Result<PathBuf, Er
             }
             // A protocol's averages are its last averaged stage's, as grainlab's summary.
             let averaged: Vec<WallRow> = match info.stages.iter().rev().find(|st| st.average) {
-                Some(st) => {
-                    // (Row times are step x dt, as these bounds.)
-                    let (from, to) = (st.first_step as f64 * info.time_step_s, (st.first_step + st.steps) as f64 * info.time_step_s);
-                    series.iter().filter(|r| r.time_s > from && r.time_s <= to).copied().collect()
-                }
+                Some(st) => series.iter().filter(|r| st.holds(r.time_s, info.time_step_s)).copied().collect(),
                 None => series.clone(),
             };
             if averaged.len() < 4 {

@@ -76,6 +76,14 @@ pub struct ExportStage {
     pub average: bool,
 }
 
+impl ExportStage {
+    /// Whether a row at `time_s` (its step times `dt`, s, as the rows' times are) falls
+    /// in this stage: after its first step's start, up to its last step.
+    pub fn holds(&self, time_s: f64, dt: f64) -> bool {
+        time_s > self.first_step as f64 * dt && time_s <= (self.first_step + self.steps) as f64 * dt
+    }
+}
+
 /// Columns of series.txt for an impact scene with `two` grains (else one grain on a wall).
 pub fn impact_columns(two: bool) -> Vec<String> {
     let mut c = vec!["step".to_string()];

@@ -130,7 +130,7 @@ pub(crate) fn deck(scene: &Scene, ex: &Exported) -> Result<String, Error> {
             }
             let _ = writeln!(w, "fix rec all print 1 \"{}\" file series.txt screen no title \"{}\"", cols.join(" "), info.columns.join(" "));
         }
-        Analysis::Shear => record_walls(w, info.sample_every, &wall_vars, &format!("file walls.txt screen no title \"{}\"", info.columns.join(" "))),
+        Analysis::Shear => record_walls(w, info.sample_every, &wall_vars, &info.columns),
         Analysis::None => {
             let _ = writeln!(w, "{}", if ex.bench { "# timing deck: nothing recorded" } else { "# analysis none: nothing recorded" });
         }
@@ -142,9 +142,9 @@ pub(crate) fn deck(scene: &Scene, ex: &Exported) -> Result<String, Error> {
 
 /// The wall series' recording: the wall forces averaged over every `k` steps and the gap
 /// at the row's step (as grainlab's rows: forces averaged over the interval, the gap where
-/// the walls are at its end), printed to walls.txt with `file_args`. `k = 1` prints every
-/// step's forces as they are (a protocol's raw series, averaged by the digest).
-fn record_walls(w: &mut String, k: u64, wall_vars: &[WallVars], file_args: &str) {
+/// the walls are at its end), printed to walls.txt under a title line of `columns`. `k = 1`
+/// prints every step's forces as they are (a protocol's raw series, averaged by the digest).
+fn record_walls(w: &mut String, k: u64, wall_vars: &[WallVars], columns: &[String]) {
     let (bot, top) = (&wall_vars[0], &wall_vars[1]);
     let _ = writeln!(w, "variable gap equal y[{}]-y[{}]", top.3, bot.3);
     let forces = [&bot.1, &bot.2, &top.1, &top.2];
@@ -158,7 +158,7 @@ fn record_walls(w: &mut String, k: u64, wall_vars: &[WallVars], file_args: &str)
         cols.push(format!("${{a{}}}", j + 1));
     }
     cols.push("${gap}".into());
-    let _ = writeln!(w, "fix rec all print {k} \"{}\" {file_args}", cols.join(" "));
+    let _ = writeln!(w, "fix rec all print {k} \"{}\" file walls.txt screen no title \"{}\"", cols.join(" "), columns.join(" "));
 }
 
 /// A wall's recorded quantities: its name, the fix outputs of its x and y force, and its
@@ -183,7 +183,7 @@ fn stages(w: &mut String, header: &mut String, scene: &Scene, ex: &Exported, rec
     let phases = crate::study::protocol::phases(scene, info.time_step_s, info.length_m, info.depth_m)?;
     let mut control: Vec<Control> = e.walls().iter().map(|wall| wall.control).collect();
     if record == Analysis::Shear {
-        record_walls(w, 1, wall_vars, &format!("file walls.txt screen no title \"{}\"", info.columns.join(" ")));
+        record_walls(w, 1, wall_vars, &info.columns);
     }
     // (A stage's gravity and a protocol beside a flat wall were refused in `prepare`.)
     for (k, ph) in phases.iter().enumerate() {

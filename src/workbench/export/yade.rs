@@ -217,17 +217,27 @@ fn stages(scene: &Scene, ex: &Exported) -> Result<String, Error> {
         rows.push(format!("    ({:?}, {}, {}, {}, {}, {}, {}, {load}),", ph.name, ph.first, ph.steps, py(b.velocity_x), py(b.velocity_y), py(t.velocity_x), py(t.velocity_y)));
     }
     let total = phases.last().map_or(0, |p| p.last());
-    let run = SHEAR_RUN
-        .replace("        for k in range(4):\n            acc[k] = 0.0\n", "        for k in range(4):\n            acc[k] = 0.0\n    while NEXT[0] < len(STAGES) and STAGES[NEXT[0]][1] == O.iter:\n        begin(STAGES[NEXT[0]])\n")
-        .replace(
-            "O.run(STEPS, True)\n",
-            &format!(
-                "# name, first step, steps, bottom vx, vy, top vx, vy (None: unchanged), top load (N; 0 held, None unchanged)\nSTAGES = [\n{}\n]\n{STAGE_BEGIN}\nbegin(STAGES[0])\nO.run({} + 1, True)\n",
-                rows.join("\n"),
-                total
-            ),
-        );
+    // The plain run's script, its record() ending with the stage changes and its O.run
+    // replaced by the stages' (each piece found once: a template edited out of step with
+    // this fails every protocol export's test, not silently).
+    let reset = "        for k in range(4):\n            acc[k] = 0.0\n";
+    let run = edited(SHEAR_RUN, reset, &format!("{reset}    while NEXT[0] < len(STAGES) and STAGES[NEXT[0]][1] == O.iter:\n        begin(STAGES[NEXT[0]])\n"));
+    let run = edited(
+        &run,
+        "O.run(STEPS, True)\n",
+        &format!(
+            "# name, first step, steps, bottom vx, vy, top vx, vy (None: unchanged), top load (N; 0 held, None unchanged)\nSTAGES = [\n{}\n]\n{STAGE_BEGIN}\nbegin(STAGES[0])\nO.run({} + 1, True)\n",
+            rows.join("\n"),
+            total
+        ),
+    );
     Ok(format!("NEXT = [0]  # the next stage to begin\n{run}"))
+}
+
+/// `text` with its one occurrence of `from` replaced by `to`.
+fn edited(text: &str, from: &str, to: &str) -> String {
+    assert_eq!(text.matches(from).count(), 1, "the script template holds `{from}` once");
+    text.replacen(from, to, 1)
 }
 
 const STAGE_BEGIN: &str = r#"def begin(stage):
