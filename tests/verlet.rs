@@ -3,7 +3,7 @@
 //! finds every touching pair among the listed ones.
 
 use grainlab::build_with;
-use grainlab::kernels::cells::brute_force_pairs;
+use grainlab::kernels::cells::{brute_force_pairs, mean_overlap};
 use grainlab::scene::builtin::shear_cell;
 
 #[test]
@@ -23,6 +23,18 @@ fn every_touching_pair_is_in_the_list_at_every_step() {
     // Rebuilt several times over the run.
     assert!(sim.engine.neighbour_builds() > 3, "{} builds", sim.engine.neighbour_builds());
     assert!(checked == 800 && sim.engine.touching() > 200, "{} touching", sim.engine.touching());
+    // The mean overlap over radius of the sheared packing (the sweep's price of soft
+    // grains), from the cell list, against the same mean over the brute-force pairs.
+    let p = sim.engine.particles();
+    let b = sim.engine.boundary();
+    let pairs = brute_force_pairs(&p.x, &p.r, p.n_free, &b, 0.0);
+    let sum: f64 = pairs.iter().map(|&[i, j]| {
+        let (i, j) = (i as usize, j as usize);
+        (p.r[i] + p.r[j] - b.image(p.x[i] - p.x[j]).norm()) / (0.5 * (p.r[i] + p.r[j]))
+    }).sum();
+    let (mean, count) = mean_overlap(&p.x, &p.r, p.n_free, &b).unwrap();
+    assert_eq!(count, pairs.len());
+    approx::assert_relative_eq!(mean, sum / pairs.len() as f64, max_relative = 1e-12);
 }
 
 /// A step's final half kick left to the next drift (`advance(false)`, what the run loop

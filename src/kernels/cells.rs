@@ -123,6 +123,32 @@ pub fn largest_overlap(x: &[Vec2], r: &[f64], n_free: usize, boundary: &Boundary
     worst
 }
 
+/// The overlapping pairs (not both wall grains) of a state: their mean overlap over the
+/// pair's mean radius, `mean(dn / ((r_i + r_j) / 2))`, and their count; `None` when no
+/// pair overlaps. The price of soft grains in a packing (about the inverse of the
+/// stiffness number under a confining stress).
+pub fn mean_overlap(x: &[Vec2], r: &[f64], n_free: usize, boundary: &Boundary) -> Option<(f64, usize)> {
+    if x.len() < 2 {
+        return None;
+    }
+    let (mut cs, mut ci) = (Vec::new(), Vec::new());
+    let cells = CellList::new(x, r, boundary, 0.0, &mut cs, &mut ci);
+    let (mut sum, mut count) = (0.0, 0usize);
+    for i in 0..x.len() {
+        cells.candidates(i, |j| {
+            if j > i && (i < n_free || j < n_free) {
+                let dn = r[i] + r[j] - boundary.image(x[i] - x[j]).norm();
+                if dn > 0.0 {
+                    sum += dn / (0.5 * (r[i] + r[j]));
+                    count += 1;
+                }
+            }
+            true
+        });
+    }
+    (count > 0).then(|| (sum / count as f64, count))
+}
+
 /// A cell list: square-ish cells at least one contact reach (`2 r_max + skin`) wide over
 /// the grains' bounding box, so that a grain's partners are in its cell or the eight
 /// around it. Dense (a counting sort into a grid) when the grid has no more cells than a

@@ -98,6 +98,11 @@ pub struct ShearSummary {
     /// 2D packing fraction at the end (free grains' disk area over the gap area); not
     /// known for a reference code's wall output.
     pub packing_fraction: Option<f64>,
+    /// Mean overlap of the touching grain pairs over their mean radius at the end of the
+    /// run (`kernels::cells::mean_overlap`), the price of soft grains; absent for an
+    /// earlier stage, a reference code's output, or a packing with no contact.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mean_overlap_rel: Option<f64>,
     /// Why an interval is less than it says: the averaged rows too short for two
     /// automatic blocks of a quantity (its interval then comes from 2 blocks shorter than
     /// 8 autocorrelation times: wide, and still maybe too narrow). None when all hold.
@@ -136,7 +141,7 @@ pub fn stress_estimates(rows: &[WallRow], packing_fraction: Option<f64>, statist
             named.join(", ")
         )
     });
-    ShearSummary { averaged_from_s: kept[0].time_s, shear_stress_pa, normal_stress_pa, stress_ratio, packing_fraction, warning }
+    ShearSummary { averaged_from_s: kept[0].time_s, shear_stress_pa, normal_stress_pa, stress_ratio, packing_fraction, mean_overlap_rel: None, warning }
 }
 
 #[cfg(test)]

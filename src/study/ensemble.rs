@@ -29,6 +29,17 @@ pub struct EnsembleRun {
     pub shear_stress_pa: Option<Estimate>,
     pub normal_stress_pa: Option<Estimate>,
     pub packing_fraction: Option<f64>,
+    /// Mean overlap over radius at the end ([`crate::observe::stress::ShearSummary`]).
+    pub mean_overlap_rel: Option<f64>,
+    /// The run's time step, s, and steps per Hertz contact time.
+    pub dt_s: f64,
+    pub steps_per_contact: f64,
+    /// Steps run, and the grains stepped.
+    pub steps: u64,
+    pub grains: usize,
+    /// The energy ledger's largest residual over the energy put in, if kept.
+    pub energy_residual_rel: Option<f64>,
+    /// Wall-clock time of the time stepping, s (the run's own clock).
     pub wall_time_s: f64,
 }
 
@@ -67,6 +78,7 @@ pub struct Ensemble {
     pub shear_stress_pa: Option<EnsembleStat>,
     pub normal_stress_pa: Option<EnsembleStat>,
     pub packing_fraction: Option<EnsembleStat>,
+    pub mean_overlap_rel: Option<EnsembleStat>,
 }
 
 /// The seeds a `--seeds` value names: `A..B` (both included) or a comma-separated list.
@@ -121,6 +133,12 @@ pub fn ensemble(scene: &Scene, seeds: &[u64], duration: Option<f64>, threads: us
             shear_stress_pa: shear.map(|x| x.shear_stress_pa),
             normal_stress_pa: shear.map(|x| x.normal_stress_pa),
             packing_fraction: shear.and_then(|x| x.packing_fraction),
+            mean_overlap_rel: shear.and_then(|x| x.mean_overlap_rel),
+            dt_s: sum.time_step.dt_s,
+            steps_per_contact: sum.time_step.steps_per_contact,
+            steps: sum.steps,
+            grains: sum.grains,
+            energy_residual_rel: sum.energy.as_ref().map(|e| e.max_residual_rel),
             wall_time_s: sum.wall_time_s,
         };
         each(&run);
@@ -135,6 +153,7 @@ pub fn ensemble(scene: &Scene, seeds: &[u64], duration: Option<f64>, threads: us
         shear_stress_pa: of(&|r| r.shear_stress_pa),
         normal_stress_pa: of(&|r| r.normal_stress_pa),
         packing_fraction: stat(&done.iter().filter_map(|r| r.packing_fraction).map(|x| (x, None)).collect::<Vec<_>>()),
+        mean_overlap_rel: stat(&done.iter().filter_map(|r| r.mean_overlap_rel).map(|x| (x, None)).collect::<Vec<_>>()),
         runs,
     })
 }

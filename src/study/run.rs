@@ -483,7 +483,12 @@ fn drive(scene: &Scene, mut built: Built, opts: &RunOptions, resumed: Option<(Ou
     let mut from = 0;
     for (phase, &to) in phases.iter().zip(&st.stage_ends) {
         let rows = &st.wall_rows[from..to];
-        let averaged = (scene.analysis == Analysis::Shear && phase.average && rows.len() >= 4).then(|| shear_summary(rows, e.particles(), length, &scene.statistics));
+        let mut averaged = (scene.analysis == Analysis::Shear && phase.average && rows.len() >= 4).then(|| shear_summary(rows, e.particles(), length, &scene.statistics));
+        // The end state is the last stage's: its overlaps are that stage's.
+        if let Some(a) = averaged.as_mut().filter(|_| to == st.wall_rows.len()) {
+            let p = e.particles();
+            a.mean_overlap_rel = crate::kernels::cells::mean_overlap(&p.x, &p.r, p.n_free, &e.boundary()).map(|m| m.0);
+        }
         if averaged.is_some() {
             shear.clone_from(&averaged);
         }
