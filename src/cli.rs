@@ -121,8 +121,11 @@ enum Command {
         #[arg(long)]
         csv: Option<PathBuf>,
     },
-    /// Run a scene over a list of time steps (and model variants) and write one CSV row
-    /// per run: dt, cost, and errors against the converged run and closed form.
+    /// Run a scene over one lever, the time step or the grains' stiffness (and model
+    /// variants), and write one CSV row per run: dt, overlap, stiffness number, cost
+    /// (median of repeated timings), and errors against a reference from runs beyond the
+    /// listed range (Richardson-extrapolated in dt, or extrapolated to rigid grains), and
+    /// against closed forms.
     Sweep {
         scene: String,
         /// Steps per Hertz contact time, comma-separated (e.g. 25,50,100,200).
@@ -131,6 +134,18 @@ enum Command {
         /// Fractions of the Rayleigh time, comma-separated.
         #[arg(long, value_delimiter = ',')]
         rayleigh: Vec<f64>,
+        /// Scales of every material's Young's modulus, comma-separated (e.g.
+        /// 0.001,0.01,0.1,1): two or more make stiffness the lever, at the scene's time
+        /// step rule or one listed step.
+        #[arg(long, value_delimiter = ',')]
+        stiffness: Vec<f64>,
+        /// Timed runs of each point of a deterministic scene; the cost is their median.
+        #[arg(long, default_value_t = 1)]
+        repeats: usize,
+        /// Packing seeds (A..B or a list): every point an ensemble over them, its values
+        /// ensemble means with 95% intervals from the run-to-run spread.
+        #[arg(long)]
+        seeds: Option<String>,
         /// Model variant families: tangential, clamp, lever (comma-separated).
         #[arg(long, value_delimiter = ',')]
         variants: Vec<String>,
@@ -319,8 +334,8 @@ fn execute(cli: Cli) -> Result<(), Error> {
             say!("{}", out.display())
         }
         Command::Compare { root, filter, csv } => compare(&root, filter.as_deref(), csv.as_deref()),
-        Command::Sweep { scene, steps, rayleigh, variants, duration, out } => {
-            use grainlab::study::sweep::{Step, Variant, sweep};
+        Command::Sweep { scene, steps, rayleigh, stiffness, repeats, seeds, variants, duration, out } => {
+            use grainlab::study::sweep::{Step, SweepPlan, Variant, sweep};
             let scene = load_scene(&scene)?;
             let mut st: Vec<Step> = steps.iter().map(|&n| Step::PerContact(n)).collect();
             st.extend(rayleigh.iter().map(|&f| Step::Rayleigh(f)));
@@ -328,6 +343,7 @@ fn execute(cli: Cli) -> Result<(), Error> {
                 let (ok, v) = match *s {
                     Step::PerContact(n) => (n.is_finite() && n >= 1.0, n),
                     Step::Rayleigh(f) => (f > 0.0 && f <= 1.0, f),
+                    Step::Scene => (true, 0.0),
                 };
                 grainlab::error::check_option(ok, if matches!(s, Step::PerContact(_)) { "--steps" } else { "--rayleigh" }, v, ">= 1 steps per contact, or a Rayleigh fraction in (0, 1]")?;
             }
@@ -335,7 +351,9 @@ fn execute(cli: Cli) -> Result<(), Error> {
             for f in &variants {
                 vars.extend(Variant::family(f)?);
             }
-            let rows = sweep(&scene, &st, &vars, duration, &limits, |r| note!("{:<28} {:<16} dt = {:.3e} s  {:.1} ns/particle-step", r.variant, r.rule, r.dt_s, r.ns_per_particle_step))?;
+            let seeds = seeds.as_deref().map(grainlab::study::ensemble::parse_seeds).transpose()?.unwrap_or_default();
+            let plan = SweepPlan { steps: st, stiffness, variants: vars, duration, repeats, seeds };
+            let rows = sweep(&scene, &plan, &limits, |line| note!("{line}"))?;
             match out {
                 Some(path) => {
                     let mut w = CsvSeries::staged(&path)?;

@@ -49,8 +49,9 @@
 //!    the checkpoint a run resumes from ([`output::checkpoint`]: versioned, checksummed).
 //! 7. **Studies** ([`study`]): a run with its progress bar, observers and outputs, ended
 //!    early on a stop request with everything written, checkpointed and resumed bit for
-//!    bit ([`study::run`], [`study::protocol`]: a scene's stages as phases of the run); sweeps over time
-//!    steps and model variants ([`study::sweep`]); the accuracy calibration that picks a
+//!    bit ([`study::run`], [`study::protocol`]: a scene's stages as phases of the run); sweeps of the
+//!    time step or the grains' stiffness, against references beyond the swept range
+//!    ([`study::sweep`]); the accuracy calibration that picks a
 //!    time step for a stated accuracy before the engine is built ([`study::accuracy`]).
 //! 8. **Workbench** ([`workbench`]): the reference cases under `reference/`
 //!    ([`workbench::cases`](mod@workbench::cases)), the digest of LIGGGHTS' and YADE's output with the engine's

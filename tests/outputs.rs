@@ -359,6 +359,10 @@ fn each_class_of_failure_has_its_exit_code() {
     bad(&["run", "collision", "--duration", "0"], "invalid option: --duration = 0");
     bad(&["sweep", "collision", "--steps", "0.5"], "invalid option: --steps = 0.5");
     bad(&["sweep", "collision", "--steps", "100", "--variants", "colour"], "invalid option: --variants = colour");
+    bad(&["sweep", "collision", "--stiffness", "0.1,-1"], "invalid option: --stiffness = -1");
+    bad(&["sweep", "collision", "--steps", "50,100", "--stiffness", "0.1,1"], "one lever per sweep");
+    bad(&["sweep", "collision", "--steps", "50", "--repeats", "0"], "invalid option: --repeats = 0");
+    bad(&["sweep", "shear", "--steps", "50", "--seeds", "4"], "invalid option: --seeds = 4");
     bad(&["run", "no-such-scene"], "neither a scene file nor a built-in");
     bad(&["run", "collision", "--no-such-flag"], "--no-such-flag");
     let restitution = scene_file(tmp.path(), "collision", "bad.json", |v| v["materials"][0]["restitution"] = 1.5.into());

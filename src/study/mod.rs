@@ -1,6 +1,6 @@
 //! Studies: a scene built and run with its observers and outputs ([`run`]), stage by
-//! stage when it is a protocol ([`protocol`]), over time
-//! steps and model variants ([`sweep`]), over packing seeds ([`ensemble`]), and the accuracy calibration that resolves an
+//! stage when it is a protocol ([`protocol`]), over the time
+//! step or the grains' stiffness, against references beyond the swept range ([`sweep`]), over packing seeds ([`ensemble`]), and the accuracy calibration that resolves an
 //! accuracy rule into a time step before the engine is built ([`accuracy`]).
 //! May use: everything below it (`output`, `observe`, `engine`, `scene`, `kernels`,
 //! `physics`).
