@@ -362,6 +362,8 @@ fn bases(dir: &Path) -> Vec<Base> {
     // 4 mm: YADE's periodic collider needs a cell of at least 4 r_max + 2 r_min (3.2 mm).
     let mut shear = builtin::shear_cell(60, 0.004);
     shear.output.frames = 0;
+    // Written only when on: a base that holds it, for the walk to change.
+    shear.output.contacts = true;
     let base = |name, s: &Scene| Base { name, scene: json_of(s), only: &[], variant_of: None };
     let focus = |name, s: &Scene, only| Base { name, scene: json_of(s), only, variant_of: None };
     let variant = |name, s: &Scene, of, leaf, only| Base { name, scene: json_of(s), only, variant_of: Some((of, leaf)) };

@@ -448,6 +448,7 @@ impl Parts<'_> {
             threads: self.threads.clone(),
             kick: Default::default(),
             zeroed: Default::default(),
+            probe: Default::default(),
             domain: self.domain,
             context: self.context,
         };
@@ -460,6 +461,9 @@ impl Parts<'_> {
             }
             if let Some(c) = scene.model.general_damping {
                 s.push(Box::new(GeneralDamping::<E>::new(c)));
+            }
+            if scene.output.contacts {
+                s.push(if rotation { Box::new(RecordContacts::<true>) } else { Box::new(RecordContacts::<false>) });
             }
             s.push(if rotation { pair_stage::<Dm, T, E, true>(&threads) } else { pair_stage::<Dm, T, E, false>(&threads) });
             if has_flat {

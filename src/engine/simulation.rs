@@ -7,7 +7,7 @@ use std::time::{Duration, Instant};
 use crate::engine::world::{MotionChange, Stage, View, World};
 use crate::error::Error;
 use crate::physics::boundary::Boundary;
-use crate::physics::contact::ContactLaw;
+use crate::physics::contact::{ContactLaw, ContactRecord};
 use crate::physics::energy::EnergyRow;
 use crate::physics::particles::Particles;
 use crate::physics::walls::Wall;
@@ -147,9 +147,17 @@ pub trait Engine: Send {
     /// Take a state [`Engine::save`] encoded, of a simulation built from the same scene;
     /// an error says what does not fit.
     fn restore(&mut self, bytes: &[u8]) -> Result<(), String>;
-    /// A read-only view of the state, what observers and outputs read.
+    /// Ask for the contacts of the next step (recorded only where the scene's
+    /// `output.contacts` put the `RecordContacts` stage in the pipeline).
+    fn want_contacts(&mut self);
+    /// The contacts of the last step that recorded them, and that step (0: none).
+    fn contacts(&self) -> (&[ContactRecord], u64);
+    /// A read-only view of the state, what observers and outputs read: the contacts are
+    /// there when they are of this very step.
     fn view(&self) -> View<'_> {
-        View { particles: self.particles(), walls: self.walls(), boundary: self.boundary(), time: self.time() }
+        let (contacts, at) = self.contacts();
+        let contacts = if at == self.steps() && at > 0 { contacts } else { &[] };
+        View { particles: self.particles(), contacts, walls: self.walls(), boundary: self.boundary(), time: self.time() }
     }
 }
 
@@ -210,5 +218,11 @@ impl<L: ContactLaw> Engine for Simulation<L> {
     }
     fn restore(&mut self, bytes: &[u8]) -> Result<(), String> {
         Simulation::restore(self, bytes)
+    }
+    fn want_contacts(&mut self) {
+        self.world.probe.wanted = true;
+    }
+    fn contacts(&self) -> (&[ContactRecord], u64) {
+        (&self.world.probe.contacts, self.world.probe.step)
     }
 }

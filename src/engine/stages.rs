@@ -7,11 +7,11 @@
 
 use crate::engine::world::World;
 use crate::error::Error;
-use crate::kernels::driver::{PairOut, PairSlices, PairView, compute_pairs};
+use crate::kernels::driver::{PairOut, PairSlices, PairView, compute_pairs, record_pair};
 use crate::kernels::sweep::sort_pairs;
 use crate::physics::contact::damping::Damping;
 use crate::physics::contact::tangential::Tangential;
-use crate::physics::contact::{ContactInput, ContactLaw, ContactModel};
+use crate::physics::contact::{ContactInput, ContactLaw, ContactModel, ContactRecord, Partner};
 use crate::physics::dim::{Vec2, cross};
 use crate::physics::walls::{Control, Surface};
 
@@ -210,6 +210,67 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN: bool> Stage<Con
         w.p.f = f;
         w.p.torque = torque;
         w.max_overlap = worst;
+        Ok(())
+    }
+}
+
+/// Record every touching contact of this step, grain-grain and grain-flat wall, as the
+/// contact stages that follow will compute it, when the run wants it (`w.probe.wanted`):
+/// the same contact law on the same inputs, on copies of the tangential states. Placed
+/// right before the grain-grain contact stage; in the pipeline only when the scene's
+/// `output.contacts` asks, and at the other steps a flag test.
+pub struct RecordContacts<const SPIN: bool>;
+
+impl<Dm: Damping, T: Tangential, const SPIN: bool> Stage<ContactModel<Dm, T>> for RecordContacts<SPIN> {
+    fn name(&self) -> String {
+        "RecordContacts".into()
+    }
+    fn run(&mut self, w: &mut World<ContactModel<Dm, T>>) -> Result<(), Error> {
+        if !w.probe.wanted {
+            return Ok(());
+        }
+        let mut out = std::mem::take(&mut w.probe.contacts);
+        out.clear();
+        let view = PairView { p: &w.p, boundary: w.boundary, law: w.law, pair_table: &w.pair_table, dt: w.dt };
+        for (k, &[i, j]) in w.pairs.pairs.checked().pairs().iter().enumerate() {
+            if let Some(c) = record_pair::<Dm, T, SPIN>(&view, (i as usize, j as usize), &w.pairs.consts[k], &w.pairs.hist[k]) {
+                out.push(c);
+            }
+        }
+        let (model, p) = (w.law, &w.p);
+        let lever = model.options.lever_arm;
+        for (k, wall) in w.walls.iter().enumerate() {
+            if !wall.is_flat() {
+                continue;
+            }
+            let n = Vec2::new(0.0, wall.side);
+            for i in 0..p.n_free {
+                let gap = wall.side * (p.x[i].y - wall.y);
+                let ri = p.r[i];
+                if gap >= ri {
+                    continue;
+                }
+                // As FlatWallForces computes it, on a copy of the history.
+                let dn = ri - gap;
+                let spin = if T::FRICTION { lever.arm(ri, dn) * p.omega[i] } else { 0.0 };
+                let input = ContactInput { n, dn, r_star: ri, sqrt_m_star: p.m[i].sqrt(), v_rel: p.v[i] - wall.v, spin, dt: w.dt, tangential_scale: 1.0 };
+                let pm = w.pair_table.get(p.material[i] as usize, wall.material);
+                let mut h = w.wall_hist[k][i].tangential;
+                let c = model.force(&input, pm, &mut h);
+                out.push(ContactRecord {
+                    i: i as u32,
+                    partner: Partner::Wall(k as u32),
+                    normal: n,
+                    overlap: dn,
+                    branch: n * gap,
+                    point: p.x[i] - n * gap,
+                    normal_force: c.normal,
+                    tangential_force: c.tangential.elastic + c.tangential.damping,
+                    sliding: c.tangential.slip_energy > 0.0,
+                });
+            }
+        }
+        w.probe = crate::engine::world::Probe { wanted: false, contacts: out, step: w.step };
         Ok(())
     }
 }

@@ -8,7 +8,7 @@ use crate::error::Error;
 use crate::kernels::pairs::PairList;
 use crate::physics::boundary::Boundary;
 use crate::physics::contact::tangential::Tangential;
-use crate::physics::contact::{ContactHistory, ContactLaw};
+use crate::physics::contact::{ContactHistory, ContactLaw, ContactRecord};
 use crate::physics::dim::Vec2;
 use crate::physics::energy::{EnergyLedger, EnergyRow};
 use crate::physics::material::PairTable;
@@ -55,6 +55,20 @@ pub struct World<L: ContactLaw> {
     /// the drift sets the free grains' to zero once it has used them, and
     /// [`crate::engine::stages::ClearForces`] clears the rest (then sets these back to 0).
     pub zeroed: Zeroed,
+    /// The contacts of one step, recorded when a run asks ([`Probe`]).
+    pub probe: Probe,
+}
+
+/// The contact record of one step: set `wanted` before the step, and the scene's
+/// `RecordContacts` stage (present only when the scene's `output.contacts` asks for it)
+/// fills `contacts` with every touching contact as the contact stages apply it at that
+/// step, then clears `wanted`. Without the stage nothing is recorded and nothing costs.
+#[derive(Clone, Debug, Default)]
+pub struct Probe {
+    pub wanted: bool,
+    pub contacts: Vec<ContactRecord>,
+    /// The step the contacts are of (0: none recorded yet).
+    pub step: u64,
 }
 
 impl<L: ContactLaw> World<L> {
@@ -217,6 +231,9 @@ pub const MAX_RESIDUAL: f64 = 0.5;
 #[derive(Clone, Copy)]
 pub struct View<'a> {
     pub particles: &'a Particles,
+    /// The contacts of the last step that recorded them (empty unless the scene asks
+    /// for contacts and the run wanted them at this step).
+    pub contacts: &'a [ContactRecord],
     pub walls: &'a [Wall],
     pub boundary: Boundary,
     /// Simulated time, s.

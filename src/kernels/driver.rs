@@ -12,7 +12,7 @@ use crate::physics::boundary::Boundary;
 use crate::physics::contact::damping::Damping;
 use crate::physics::contact::tangential::Tangential;
 use crate::physics::contact::model::ContactState;
-use crate::physics::contact::{ContactInput, ContactLaw, ContactModel, EnergyMemory, LeverArm};
+use crate::physics::contact::{ContactInput, ContactLaw, ContactModel, ContactRecord, EnergyMemory, LeverArm, Partner};
 use crate::physics::dim::{Vec2, cross};
 use crate::physics::lanes::{LANES, Lanes, Real, gather, gather2, lane2};
 use crate::physics::material::PairMaterial;
@@ -188,6 +188,33 @@ fn one_pair<Dm: Damping, T: Tangential, const SPIN: bool>(
     *active = true;
     let torque = if T::FRICTION && SPIN { pair_torque(lever, &input, c.tangential.elastic + c.tangential.damping, p.r[i], p.r[j]) } else { [0.0, 0.0] };
     (PairOut { force: c.force, torque, ratio: input.dn * pc.inv_r_min }, input.n, c)
+}
+
+/// Grain-grain pair `(i, j)` as the contact stage is about to compute it at this step
+/// (positions, velocities and tangential state `h` as they are now): its record, or
+/// `None` when it does not touch. The same function of the same inputs as the stage's
+/// (`one_pair`, whose lanes give the same bits), on a copy of the state: nothing moves.
+pub fn record_pair<Dm: Damping, T: Tangential, const SPIN: bool>(w: &PairView<'_, ContactModel<Dm, T>>, (i, j): (usize, usize), pc: &PairConst, h: &T::History<f64>) -> Option<ContactRecord> {
+    let p = w.p;
+    let d = w.boundary.image(p.x[i] - p.x[j]);
+    let (ri, rj) = (p.r[i], p.r[j]);
+    if d.norm_squared() >= (ri + rj) * (ri + rj) {
+        return None;
+    }
+    let (mut h, mut active) = (*h, true);
+    let (_, n, c) = one_pair::<Dm, T, SPIN>(w, (i, j), d, pc, &mut h, &mut active);
+    let dn = ri + rj - d.norm();
+    Some(ContactRecord {
+        i: i as u32,
+        partner: Partner::Grain(j as u32),
+        normal: n,
+        overlap: dn,
+        branch: d,
+        point: p.x[i] - n * (ri - 0.5 * dn),
+        normal_force: c.normal,
+        tangential_force: c.tangential.elastic + c.tangential.damping,
+        sliding: c.tangential.slip_energy > 0.0,
+    })
 }
 
 /// A part of the pair list: the pairs, their constants, tangential states, energy

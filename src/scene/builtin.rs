@@ -49,7 +49,7 @@ pub fn head_on(material: Material, r: f64, v: f64, steps_per_contact: f64) -> Sc
         // The approach and three contact times (the run stops at separation anyway).
         duration: 2.0 * gap / v + 3.0 * crate::physics::material::hertz_contact_time(m / 2.0, r / 2.0, e_star, v),
         neighbor: NeighborSpec::default(),
-        output: OutputSpec { samples: 200, frames: 0, energy: true },
+        output: OutputSpec { samples: 200, frames: 0, energy: true, contacts: false },
         analysis: Analysis::Impact,
         statistics: Default::default(),
         stages: Vec::new(),
@@ -125,7 +125,7 @@ pub fn shear() -> Scene {
         time_step: TimeStepSpec { rule: TimeStepRule::StepsPerContact { steps: 50.0, impact_speed: v }, characteristic_speed: None, allow_unstable: false },
         duration: 0.05,
         neighbor: NeighborSpec::default(),
-        output: OutputSpec { samples: 400, frames: 20, energy: true },
+        output: OutputSpec { samples: 400, frames: 20, energy: true, contacts: false },
         analysis: Analysis::Shear,
         statistics: Default::default(),
         stages: Vec::new(),

@@ -405,6 +405,11 @@ pub struct OutputSpec {
     /// Track the energy balance. Default true.
     #[serde(default = "yes")]
     pub energy: bool,
+    /// Record every contact at each sample (and frame): the packing's stress tensor,
+    /// coordination, sliding fraction and fabric go to `packing.csv`. Default false (no
+    /// recording stage in the pipeline, nothing to pay; left out of written scenes).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub contacts: bool,
 }
 
 fn default_samples() -> u64 {
@@ -416,7 +421,7 @@ fn default_frames() -> u64 {
 
 impl Default for OutputSpec {
     fn default() -> Self {
-        OutputSpec { samples: default_samples(), frames: default_frames(), energy: true }
+        OutputSpec { samples: default_samples(), frames: default_frames(), energy: true, contacts: false }
     }
 }
 

@@ -4,6 +4,8 @@
 pub mod damping;
 pub mod model;
 pub mod normal;
+pub mod record;
 pub mod tangential;
 
+pub use record::{ContactRecord, Partner};
 pub use model::{ContactForce, ContactHistory, EnergyMemory, ContactInput, ContactLaw, ContactModel, LeverArm, ModelOptions};

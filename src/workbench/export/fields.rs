@@ -296,6 +296,7 @@ pub const FIELDS: &[Field] = &[
         written("steps per walls.txt row (shear scripts: SAMPLE), export.json sample_every; impact scripts record every step"),
     ),
     both("output.frames", outside(NOT_PHYSICS_OUTPUT)),
+    both("output.contacts", outside("grainlab's own record of the contacts (packing.csv), read from the forces the step computes without changing them")),
     both("output.energy", outside("grainlab's energy ledger, a compile-time switch that leaves the forces as they are; the decks record states and forces")),
     both(
         "analysis",
