@@ -63,6 +63,9 @@ struct Outputs {
     folder: Option<OutFolder>,
     energy: Option<CsvSeries>,
     walls: Option<CsvSeries>,
+    /// packing.csv: the packing's stress, coordination and fabric at each sample (the
+    /// scene's `output.contacts`).
+    packing: Option<CsvSeries>,
     vtk: Option<VtkSeries>,
 }
 
@@ -160,9 +163,10 @@ pub fn resume(dir: &Path, threads: Option<usize>, opts: &RunOptions) -> Result<R
     let mut folder = OutFolder::reopen(dir, &state.frames.iter().map(|f| f.1.clone()).collect::<Vec<_>>())?;
     let energy = state.energy_bytes.map(|b| folder.resume_series("energy.csv", b)).transpose()?;
     let walls = state.walls_bytes.map(|b| folder.resume_series("walls.csv", b)).transpose()?;
+    let packing = state.packing_bytes.map(|b| folder.resume_series("packing.csv", b)).transpose()?;
     let vtk = if state.frames.is_empty() { None } else { Some(VtkSeries::resume(state.frames.clone(), &mut folder)?) };
     let opts = RunOptions { out: Some(dir.to_path_buf()), duration: c.duration, checkpoint_every: opts.checkpoint_every.or(c.every_s), ..opts.clone() };
-    let outputs = Outputs { folder: Some(folder), energy, walls, vtk };
+    let outputs = Outputs { folder: Some(folder), energy, walls, packing, vtk };
     drive(&scene, built, &opts, Some((outputs, state)))
 }
 
@@ -188,6 +192,7 @@ struct LoopState {
     /// Bytes of energy.csv and walls.csv written (none: the run writes no such series).
     energy_bytes: Option<u64>,
     walls_bytes: Option<u64>,
+    packing_bytes: Option<u64>,
     /// The frames written (time, s; file): none when the run writes none (a run that
     /// does has written its first before any checkpoint).
     frames: Vec<(f64, String)>,
@@ -223,6 +228,9 @@ impl LoopState {
             }
             self.wall_rows.push(row);
         }
+        if let (Some(s), Some(row)) = (out.packing.as_mut(), crate::observe::packing::packing_row(&e.view(), length, depth)) {
+            s.row_in(stage, &row)?;
+        }
         Ok(())
     }
 }
@@ -253,6 +261,7 @@ impl Checkpointing<'_> {
         let Some(folder) = out.folder.as_mut() else { return Ok(()) };
         st.energy_bytes = out.energy.as_mut().map(|s| s.written(true)).transpose()?;
         st.walls_bytes = out.walls.as_mut().map(|s| s.written(true)).transpose()?;
+        st.packing_bytes = out.packing.as_mut().map(|s| s.written(true)).transpose()?;
         st.frames = out.vtk.as_ref().map(|v| v.frames().to_vec()).unwrap_or_default();
         let before = std::mem::replace(&mut st.wall_time_s, wall_time_s);
         let run = postcard::to_stdvec(&*st).expect("the run state encodes");
@@ -302,7 +311,7 @@ fn drive(scene: &Scene, mut built: Built, opts: &RunOptions, resumed: Option<(Ou
             (outputs, st)
         }
         None => {
-            let mut outputs = Outputs { folder: None, energy: None, walls: None, vtk: None };
+            let mut outputs = Outputs { folder: None, energy: None, walls: None, packing: None, vtk: None };
             if let Some(dir) = &opts.out {
                 let mut folder = OutFolder::claim(dir, opts.overwrite, &format!("run {}", scene.name))?;
                 // The scene as it runs: the folder alone repeats the run.
@@ -312,6 +321,9 @@ fn drive(scene: &Scene, mut built: Built, opts: &RunOptions, resumed: Option<(Ou
                 }
                 if !built.engine.walls().is_empty() {
                     outputs.walls = Some(folder.series("walls.csv")?);
+                    if scene.output.contacts {
+                        outputs.packing = Some(folder.series("packing.csv")?);
+                    }
                 }
                 if phases.iter().any(|p| p.frame_every.is_some()) {
                     outputs.vtk = Some(VtkSeries::new(&mut folder)?);
@@ -401,6 +413,9 @@ fn drive(scene: &Scene, mut built: Built, opts: &RunOptions, resumed: Option<(Ou
             // Whether anything below looks at the grains after this step: else the step's
             // final half kick is left to the next one's drift.
             let look = sample || frame || checkpoint || stopping || st.impact.is_some();
+            if sample && scene.output.contacts {
+                e.want_contacts();
+            }
             if let Err(err) = e.advance(look) {
                 error = Some(err);
                 break 'run;
@@ -544,7 +559,7 @@ fn drive(scene: &Scene, mut built: Built, opts: &RunOptions, resumed: Option<(Ou
     }
     // Everything is tried even when one write fails; the first failure is kept.
     if let Some(folder) = outputs.folder.as_mut() {
-        for (series, name) in [(outputs.energy.take(), "energy.csv"), (outputs.walls.take(), "walls.csv")] {
+        for (series, name) in [(outputs.energy.take(), "energy.csv"), (outputs.walls.take(), "walls.csv"), (outputs.packing.take(), "packing.csv")] {
             if let Some(s) = series {
                 or_note!(name, folder.close_series(s, name));
             }
