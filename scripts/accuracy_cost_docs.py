@@ -176,6 +176,23 @@ def cost_axis(ax, x):
     ax.xaxis.set_minor_formatter(NullFormatter())
 
 
+def shear_panel(ax, rows, q, sim_ms, label, offset, ylabel, title):
+    """One shear sweep's quantity q against cost: each row's difference from its
+    reference, with the 95% intervals of both combined, and the cost's min-max."""
+    x = [r["wall_time_s"] / sim_ms for r in rows]
+    xerr = [[(r["wall_time_s"] - r["wall_time_min_s"]) / sim_ms for r in rows], [(r["wall_time_max_s"] - r["wall_time_s"]) / sim_ms for r in rows]]
+    y = [r[q] - r[q + "_reference"] for r in rows]
+    yerr = [math.hypot(r[q + "_ci95"], r[q + "_reference_uncertainty"]) for r in rows]
+    ax.errorbar(x, y, xerr=xerr, yerr=yerr, fmt="o", capsize=3)
+    ax.axhline(0, color="0.4", lw=0.8)
+    for xi, yi, r in zip(x, y, rows):
+        ax.annotate(label(r), (xi, yi), fontsize=7, xytext=offset, textcoords="offset points")
+    cost_axis(ax, x)
+    ax.set_xlabel("cost: wall-clock s per simulated ms (median of %d packings)" % rows[0]["runs"])
+    ax.set_ylabel(ylabel)
+    ax.set_title(title, fontsize=9)
+
+
 def write_page():
     col = read("collision-dt")
     el = read("collision-elastic-dt")
@@ -202,18 +219,7 @@ def write_page():
     ax.set_title("collision, time step (dotted: reference uncertainty)", fontsize=9)
     ax.legend(fontsize=7)
     for ax, q, name in [(axes[1], "stress_ratio", "tau/sigma"), (axes[2], "packing_fraction", "packing fraction")]:
-        x = [r["wall_time_s"] / sim_ms for r in sdt]
-        xerr = [[(r["wall_time_s"] - r["wall_time_min_s"]) / sim_ms for r in sdt], [(r["wall_time_max_s"] - r["wall_time_s"]) / sim_ms for r in sdt]]
-        y = [r[q] - r[q + "_reference"] for r in sdt]
-        yerr = [math.hypot(r[q + "_ci95"], r[q + "_reference_uncertainty"]) for r in sdt]
-        ax.errorbar(x, y, xerr=xerr, yerr=yerr, fmt="o", capsize=3)
-        ax.axhline(0, color="0.4", lw=0.8)
-        for xi, yi, r in zip(x, y, sdt):
-            ax.annotate(r["rule"], (xi, yi), fontsize=7, xytext=(4, 4), textcoords="offset points")
-        cost_axis(ax, x)
-        ax.set_xlabel("cost: wall-clock s per simulated ms (median of %d packings)" % sdt[0]["runs"])
-        ax.set_ylabel(f"{name} - converged reference")
-        ax.set_title(f"shear cell, time step: {name} (95% CIs incl. the reference's)", fontsize=9)
+        shear_panel(ax, sdt, q, sim_ms, lambda r: r["rule"], (4, 4), f"{name} - converged reference", f"shear cell, time step: {name} (95% CIs incl. the reference's)")
     fig.tight_layout()
     fig.savefig(os.path.join(OUT, "time-step.png"), dpi=110)
     plt.close(fig)
@@ -232,18 +238,7 @@ def write_page():
     ax.set_title("collision, stiffness (dotted: rigid reference's uncertainty)", fontsize=9)
     ax.legend(fontsize=7)
     for ax, q, name in [(axes[1], "stress_ratio", "tau/sigma"), (axes[2], "packing_fraction", "packing fraction")]:
-        x = [r["wall_time_s"] / sim_ms for r in sst]
-        y = [r[q] - r[q + "_reference"] for r in sst]
-        yerr = [math.hypot(r[q + "_ci95"], r[q + "_reference_uncertainty"]) for r in sst]
-        xerr = [[(r["wall_time_s"] - r["wall_time_min_s"]) / sim_ms for r in sst], [(r["wall_time_max_s"] - r["wall_time_s"]) / sim_ms for r in sst]]
-        ax.errorbar(x, y, xerr=xerr, yerr=yerr, fmt="o", capsize=3)
-        ax.axhline(0, color="0.4", lw=0.8)
-        for xi, yi, r in zip(x, y, sst):
-            ax.annotate(f"E x{r['stiffness_scale']:g}\nkappa {r['stiffness_number']:.0f}", (xi, yi), fontsize=7, xytext=(4, -2), textcoords="offset points")
-        cost_axis(ax, x)
-        ax.set_xlabel("cost: wall-clock s per simulated ms (median of %d packings)" % sst[0]["runs"])
-        ax.set_ylabel(f"{name} - rigid limit (extrapolated)")
-        ax.set_title(f"shear cell, stiffness: {name} (95% CIs incl. the reference's)", fontsize=9)
+        shear_panel(ax, sst, q, sim_ms, lambda r: f"E x{r['stiffness_scale']:g}\nkappa {r['stiffness_number']:.0f}", (4, -2), f"{name} - rigid limit (extrapolated)", f"shear cell, stiffness: {name} (95% CIs incl. the reference's)")
     fig.tight_layout()
     fig.savefig(os.path.join(OUT, "stiffness.png"), dpi=110)
     plt.close(fig)
