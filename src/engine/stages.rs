@@ -214,6 +214,15 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN: bool> Stage<Con
     }
 }
 
+/// The contact input of free grain `i` touching flat `wall` (normal `n` into the grain,
+/// overlap `dn`): R* = r, m* = m. Shared by the wall contact stage and the record of it.
+#[inline(always)]
+fn wall_input<T: Tangential>(lever: crate::physics::contact::LeverArm, p: &crate::physics::particles::Particles, i: usize, wall: &crate::physics::walls::Wall, n: Vec2, dn: f64, dt: f64) -> ContactInput {
+    let ri = p.r[i];
+    let spin = if T::FRICTION { lever.arm(ri, dn) * p.omega[i] } else { 0.0 };
+    ContactInput { n, dn, r_star: ri, sqrt_m_star: p.m[i].sqrt(), v_rel: p.v[i] - wall.v, spin, dt, tangential_scale: 1.0 }
+}
+
 /// Record every touching contact of this step, grain-grain and grain-flat wall, as the
 /// contact stages that follow will compute it, when the run wants it (`w.probe.wanted`):
 /// the same contact law on the same inputs, on copies of the tangential states. Placed
@@ -252,8 +261,7 @@ impl<Dm: Damping, T: Tangential, const SPIN: bool> Stage<ContactModel<Dm, T>> fo
                 }
                 // As FlatWallForces computes it, on a copy of the history.
                 let dn = ri - gap;
-                let spin = if T::FRICTION { lever.arm(ri, dn) * p.omega[i] } else { 0.0 };
-                let input = ContactInput { n, dn, r_star: ri, sqrt_m_star: p.m[i].sqrt(), v_rel: p.v[i] - wall.v, spin, dt: w.dt, tangential_scale: 1.0 };
+                let input = wall_input::<T>(lever, p, i, wall, n, dn, w.dt);
                 let pm = w.pair_table.get(p.material[i] as usize, wall.material);
                 let mut h = w.wall_hist[k][i].tangential;
                 let c = model.force(&input, pm, &mut h);
@@ -312,9 +320,7 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> 
                     continue;
                 }
                 let dn = ri - gap;
-                let ai = if T::FRICTION { lever.arm(ri, dn) } else { 0.0 };
-                let spin = if T::FRICTION { ai * p.omega[i] } else { 0.0 };
-                let input = ContactInput { n, dn, r_star: ri, sqrt_m_star: p.m[i].sqrt(), v_rel: p.v[i] - wall.v, spin, dt, tangential_scale: 1.0 };
+                let input = wall_input::<T>(lever, p, i, wall, n, dn, dt);
                 let pm = w.pair_table.get(p.material[i] as usize, wall.material);
                 let c = model.touch::<ENERGY>(&input, pm, h, &mut w.ledger);
                 active[i] = true;
