@@ -65,7 +65,8 @@ fn shear_run_writes_wall_stresses_and_paraview_frames() {
     assert!(header.contains("shear_stress_pa") && header.contains("normal_stress_pa"), "{header}");
     let pvd = std::fs::read_to_string(out.join("grains.pvd")).unwrap();
     assert!(pvd.contains("frames/grains_00000.vtp"));
-    let vtp = std::fs::read_to_string(out.join("frames/grains_00000.vtp")).unwrap();
+    // XML, then the arrays appended raw.
+    let vtp = String::from_utf8_lossy(&std::fs::read(out.join("frames/grains_00000.vtp")).unwrap()).into_owned();
     assert!(vtp.contains("<VTKFile type=\"PolyData\"") && vtp.contains("NumberOfPoints=\"10"), "{}", &vtp[..200]);
 }
 

@@ -102,3 +102,96 @@ fn the_packings_stress_balances_the_walls_in_steady_shear() {
     assert!(mean(&dyy).abs() <= half(&dyy) && half(&dyy) < 0.05 * sigma);
     assert!(mean(&dyx).abs() <= half(&dyx) && half(&dyx) < 0.05 * sigma);
 }
+
+/// The arrays of a `.vtp` written with appended raw data: name -> values (Float64 and
+/// Int64 as f64), read as a VTK reader would (offset into the block after `_`, a 64-bit
+/// byte count, then the values).
+fn read_vtp(path: &std::path::Path) -> std::collections::HashMap<String, Vec<f64>> {
+    let bytes = std::fs::read(path).unwrap();
+    let start = bytes.windows(3).position(|w| w == b"  _").unwrap() + 3;
+    let xml = String::from_utf8_lossy(&bytes[..start]).into_owned();
+    let mut out = std::collections::HashMap::new();
+    for tag in xml.split("<DataArray ").skip(1) {
+        let attr = |k: &str| tag.split(&format!("{k}=\"")).nth(1).unwrap().split('"').next().unwrap().to_string();
+        let at = start + attr("offset").parse::<usize>().unwrap();
+        let len = u64::from_le_bytes(bytes[at..at + 8].try_into().unwrap()) as usize;
+        let raw = &bytes[at + 8..at + 8 + len];
+        let values = raw
+            .chunks(8)
+            .map(|b| match attr("type").as_str() {
+                "Float64" => f64::from_le_bytes(b.try_into().unwrap()),
+                "Int64" => i64::from_le_bytes(b.try_into().unwrap()) as f64,
+                t => panic!("type {t}"),
+            })
+            .collect();
+        // Point and cell arrays may share a name (normal_force_n): the cells' come last.
+        out.insert(attr("Name"), values);
+    }
+    out
+}
+
+#[test]
+fn the_frames_contacts_are_the_steps_forces_in_both_files() {
+    // A run with output.contacts and frames writes, per frame after the first, the
+    // contacts as VTK lines and as CSV; read back from the files, each free grain's
+    // contacts sum to the force its frame holds (Newton's third law; the files keep
+    // every digit: 1e-12 of the largest force for the order of the sums), and the CSV
+    // holds the same contacts as the VTK file.
+    let mut scene = grainlab::scene::builtin::shear_cell(200, 0.012);
+    scene.output.contacts = true;
+    scene.output.frames = 2;
+    scene.duration = 4e-4;
+    let tmp = tempfile::tempdir().unwrap();
+    let opts = grainlab::study::run::RunOptions { out: Some(tmp.path().to_path_buf()), ..Default::default() };
+    grainlab::study::run::run_scene(&scene, &opts).unwrap();
+    let pvd = std::fs::read_to_string(tmp.path().join("contacts.pvd")).unwrap();
+    assert!(pvd.contains("frames/contacts_00002.vtp") && !pvd.contains("contacts_00000"), "{pvd}");
+    assert!(!tmp.path().join("frames/contacts_00000.vtp").exists(), "step 0 computed no contacts");
+    let g = read_vtp(&tmp.path().join("frames/grains_00002.vtp"));
+    let c = read_vtp(&tmp.path().join("frames/contacts_00002.vtp"));
+    let n = g["radius_m"].len();
+    let m = c["grain"].len();
+    assert!(m > 100, "{m} contacts");
+    assert_eq!(c["position_m"].len(), 6 * m, "two points per line");
+    let mut sum = vec![[0.0f64; 2]; n];
+    let mut count = vec![0.0; n];
+    for k in 0..m {
+        let (i, j) = (c["grain"][k] as usize, c["partner"][k]);
+        let f = [c["force_n"][3 * k], c["force_n"][3 * k + 1]];
+        sum[i][0] += f[0];
+        sum[i][1] += f[1];
+        count[i] += 1.0;
+        if j >= 0.0 {
+            sum[j as usize][0] -= f[0];
+            sum[j as usize][1] -= f[1];
+            count[j as usize] += 1.0;
+        }
+        // The normal and tangential parts add up to the force.
+        let fn_ = c["normal_force_n"][k];
+        for a in 0..2 {
+            let parts = c["normal"][3 * k + a] * fn_ + c["tangential_force_n"][3 * k + a];
+            assert!((parts - f[a]).abs() <= 1e-15 * fn_.abs().max(1.0));
+        }
+    }
+    let scale = (0..m).map(|k| c["normal_force_n"][k].abs()).fold(0.0, f64::max);
+    for i in (0..n).filter(|&i| g["wall_grain"][i] == 0.0) {
+        for a in 0..2 {
+            assert!((sum[i][a] - g["force_n"][3 * i + a]).abs() <= 1e-12 * scale, "grain {i}: contacts {:?}, frame {}", sum[i], g["force_n"][3 * i + a]);
+        }
+    }
+    assert_eq!(count, g["contacts"], "each grain's contact count");
+    assert_eq!(g["id"], (0..n).map(|i| i as f64).collect::<Vec<_>>());
+    // The per-grain stress: each free grain's is (x_c - x_p) f summed over its contacts,
+    // whose trace for a grain pressed from all sides is negative (tension positive).
+    let s = &g["stress_volume_n_m"];
+    assert_eq!(s.len(), 9 * n);
+    let pressed = (0..n).filter(|&i| count[i] >= 2.0 && g["wall_grain"][i] == 0.0).filter(|&i| s[9 * i] + s[9 * i + 4] < 0.0).count();
+    assert!(pressed * 10 >= 9 * (0..n).filter(|&i| count[i] >= 2.0 && g["wall_grain"][i] == 0.0).count());
+    // The CSV: one row per contact, the same numbers.
+    let csv = std::fs::read_to_string(tmp.path().join("frames/contacts_00002.csv")).unwrap();
+    let rows: Vec<Vec<f64>> = csv.lines().skip(1).map(|l| l.split(',').map(|x| x.parse().unwrap()).collect()).collect();
+    assert_eq!(rows.len(), m);
+    for (k, r) in rows.iter().enumerate() {
+        assert_eq!([r[0], r[1], r[2], r[3], r[6], r[7], r[8], r[9], r[10]], [c["grain"][k], c["partner"][k], c["contact_point_m"][3 * k], c["contact_point_m"][3 * k + 1], c["overlap_m"][k], c["normal_force_n"][k], c["tangential_force_n"][3 * k], c["tangential_force_n"][3 * k + 1], c["sliding"][k]]);
+    }
+}

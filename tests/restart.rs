@@ -14,8 +14,8 @@ use grainlab::scene::Scene;
 use grainlab::study::run::{RunOptions, RunReport, resume, run_report};
 
 /// The workbench's protocol (200 grains under 100 kPa, shear at +-0.5 m/s then +-1 m/s),
-/// its first two stages made longer and sampled less often, with frames: stages, a loaded
-/// wall, frames and rows all cross the stops.
+/// its first two stages made longer and sampled less often, with frames and contacts:
+/// stages, a loaded wall, frames and rows all cross the stops.
 fn protocol() -> Scene {
     let mut s = grainlab::workbench::cases::protocol_case();
     s.stages.truncate(2);
@@ -25,6 +25,8 @@ fn protocol() -> Scene {
     s.stages[1].samples = Some(40);
     s.duration = 1.2e-3;
     s.output.frames = 6;
+    // The contacts' frames and packing.csv too.
+    s.output.contacts = true;
     s
 }
 

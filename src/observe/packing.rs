@@ -185,3 +185,46 @@ pub fn packing_row(v: &View, length: f64, depth: f64) -> Option<PackingRow> {
         fabric_angle_deg: 0.5 * (2.0 * fxy).atan2(fxx - fyy).to_degrees(),
     })
 }
+
+/// Each grain's stress times its volume from the contacts in `v` (recorded at this
+/// step), N m, tension positive, `[xx, xy, yx, yy]` with positions along the first
+/// index and forces along the second: the sum over the grain's contacts of
+/// (x_c - x_p)_a f_b, with x_c the contact point and f the force on the grain (the
+/// contact part of the grain's Cauchy stress times its volume, as YADE's
+/// `bodyStressTensors`; LIGGGHTS' `stress/atom` splits a pair's r_ij f_ij half and half,
+/// which sums to the same over the grains). Glued grains get theirs too; a flat wall
+/// none. Divide by a grain's volume for its mean stress; summed over the free grains,
+/// the contact part of [`PackingRow`]'s stress times its volume.
+pub fn grain_stress_volumes(v: &View) -> Vec<[f64; 4]> {
+    let p = v.particles;
+    let mut s = vec![[0.0f64; 4]; p.len()];
+    let mut add = |k: usize, arm: Vec2, f: Vec2| {
+        s[k][0] += arm.x * f.x;
+        s[k][1] += arm.x * f.y;
+        s[k][2] += arm.y * f.x;
+        s[k][3] += arm.y * f.y;
+    };
+    for c in v.contacts {
+        let i = c.i as usize;
+        let f = c.force();
+        let arm = c.point - p.x[i];
+        add(i, arm, f);
+        if let Partner::Grain(j) = c.partner {
+            // The partner's image next to grain i: x_i - branch.
+            add(j as usize, arm + c.branch, -f);
+        }
+    }
+    s
+}
+
+/// Each grain's number of contacts in `v` (a wall contact counts for its grain).
+pub fn grain_contacts(v: &View) -> Vec<u32> {
+    let mut n = vec![0u32; v.particles.len()];
+    for c in v.contacts {
+        n[c.i as usize] += 1;
+        if let Partner::Grain(j) = c.partner {
+            n[j as usize] += 1;
+        }
+    }
+    n
+}

@@ -70,9 +70,10 @@ struct Outputs {
 }
 
 impl Outputs {
-    fn frame(&mut self, e: &dyn Engine) -> Result<(), Error> {
+    /// Write a frame, with the contacts the step recorded when `contacts`.
+    fn frame(&mut self, e: &dyn Engine, contacts: bool) -> Result<(), Error> {
         match (self.vtk.as_mut(), self.folder.as_mut()) {
-            (Some(v), Some(f)) => v.frame(&e.view(), f),
+            (Some(v), Some(f)) => v.frame(&e.view(), contacts, f),
             _ => Ok(()),
         }
     }
@@ -160,7 +161,7 @@ pub fn resume(dir: &Path, threads: Option<usize>, opts: &RunOptions) -> Result<R
         return refuse(why);
     }
     // Everything checked: the folder is taken back and its series cut to the checkpoint.
-    let mut folder = OutFolder::reopen(dir, &state.frames.iter().map(|f| f.1.clone()).collect::<Vec<_>>())?;
+    let mut folder = OutFolder::reopen(dir, &VtkSeries::files_of(&state.frames))?;
     let energy = state.energy_bytes.map(|b| folder.resume_series("energy.csv", b)).transpose()?;
     let walls = state.walls_bytes.map(|b| folder.resume_series("walls.csv", b)).transpose()?;
     let packing = state.packing_bytes.map(|b| folder.resume_series("packing.csv", b)).transpose()?;
@@ -350,7 +351,7 @@ fn drive(scene: &Scene, mut built: Built, opts: &RunOptions, resumed: Option<(Ou
         if let Some(o) = st.impact.as_mut() {
             o.start(&e.view());
         }
-        error = st.record_energy(e, &mut outputs, first_stage, energy_on).and_then(|()| outputs.frame(e)).err();
+        error = st.record_energy(e, &mut outputs, first_stage, energy_on).and_then(|()| outputs.frame(e, false)).err();
     }
     let mut write_error: Option<Error> = None;
     let mut unwritten: Vec<String> = Vec::new();
@@ -413,7 +414,7 @@ fn drive(scene: &Scene, mut built: Built, opts: &RunOptions, resumed: Option<(Ou
             // Whether anything below looks at the grains after this step: else the step's
             // final half kick is left to the next one's drift.
             let look = sample || frame || checkpoint || stopping || st.impact.is_some();
-            if sample && scene.output.contacts {
+            if (sample || frame) && scene.output.contacts {
                 e.want_contacts();
             }
             if let Err(err) = e.advance(look) {
@@ -442,7 +443,7 @@ fn drive(scene: &Scene, mut built: Built, opts: &RunOptions, resumed: Option<(Ou
                 or_stop!('run, st.sample(e, &mut outputs, stage, energy_on, length, depth));
             }
             if frame {
-                or_stop!('run, outputs.frame(e));
+                or_stop!('run, outputs.frame(e, scene.output.contacts));
             }
             if j == phase.steps {
                 st.stage_ends.push(st.wall_rows.len());
