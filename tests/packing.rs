@@ -195,3 +195,47 @@ fn the_frames_contacts_are_the_steps_forces_in_both_files() {
         assert_eq!([r[0], r[1], r[2], r[3], r[6], r[7], r[8], r[9], r[10]], [c["grain"][k], c["partner"][k], c["contact_point_m"][3 * k], c["contact_point_m"][3 * k + 1], c["overlap_m"][k], c["normal_force_n"][k], c["tangential_force_n"][3 * k], c["tangential_force_n"][3 * k + 1], c["sliding"][k]]);
     }
 }
+
+#[test]
+fn the_summary_and_the_profiles_balance_the_walls_across_the_gap() {
+    // A run with output.contacts: summary.json's time-averaged packing stress equals the
+    // walls' stresses (momentum balance), and so does every layer's in profiles.csv: in
+    // steady shear without gravity d sigma_yx / dy = d sigma_yy / dy = 0 across the gap.
+    // Tolerances: the run's own 95% intervals, combined in quadrature, for the whole cell
+    // (both means from the same window, blocks as the summary makes them); per layer
+    // three times that (26 layers tested at once, and a layer one diameter thick
+    // assigns a grain's whole stress to the layer of its centre).
+    let mut scene = grainlab::scene::builtin::shear_cell(300, 0.012);
+    scene.output.contacts = true;
+    scene.output.frames = 0;
+    scene.duration = 0.012;
+    let tmp = tempfile::tempdir().unwrap();
+    let opts = grainlab::study::run::RunOptions { out: Some(tmp.path().to_path_buf()), ..Default::default() };
+    let s = grainlab::study::run::run_scene(&scene, &opts).unwrap();
+    let shear = s.shear.unwrap();
+    let pk = shear.packing.expect("the packing's averages");
+    let (tau, sigma) = (shear.shear_stress_pa, shear.normal_stress_pa);
+    let within = |a: f64, b: f64, ca: f64, cb: f64, k: f64| (a - b).abs() <= k * (ca * ca + cb * cb).sqrt();
+    eprintln!("tau {:.0} +- {:.0}, sigma_yx {:.0} +- {:.0}; sigma {:.0} +- {:.0}, sigma_yy {:.0} +- {:.0}", tau.mean, tau.ci95, pk.sigma_yx_pa.mean, pk.sigma_yx_pa.ci95, sigma.mean, sigma.ci95, pk.sigma_yy_pa.mean, pk.sigma_yy_pa.ci95);
+    assert!(sigma.mean > 5e4 && tau.mean > 0.1 * sigma.mean);
+    assert!(within(pk.sigma_yx_pa.mean, tau.mean, pk.sigma_yx_pa.ci95, tau.ci95, 1.0));
+    assert!(within(-pk.sigma_yy_pa.mean, sigma.mean, pk.sigma_yy_pa.ci95, sigma.ci95, 1.0));
+    assert!(pk.coordination.mean > 2.0 && pk.coordination_without_rattlers.mean >= pk.coordination.mean);
+    let csv = std::fs::read_to_string(tmp.path().join("profiles.csv")).unwrap();
+    let mut lines = csv.lines();
+    let head: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = |name: &str| head.iter().position(|h| *h == name).unwrap();
+    let rows: Vec<Vec<f64>> = lines.map(|l| l.split(',').map(|x| x.parse().unwrap_or(f64::NAN)).collect()).collect();
+    assert!(rows.len() >= 10, "{} layers", rows.len());
+    for r in &rows {
+        let (syx, syy) = (r[col("sigma_yx_pa")], r[col("sigma_yy_pa")]);
+        assert!(within(syx, tau.mean, r[col("sigma_yx_pa_ci95")], tau.ci95, 3.0), "layer {}: sigma_yx {syx:.0} +- {:.0}, tau {:.0}", r[0], r[col("sigma_yx_pa_ci95")], tau.mean);
+        assert!(within(-syy, sigma.mean, r[col("sigma_yy_pa_ci95")], sigma.ci95, 3.0), "layer {}: sigma_yy {syy:.0}, sigma {:.0}", r[0], sigma.mean);
+        let phi = r[col("solid_fraction")];
+        assert!(phi > 0.6 && phi < 0.91, "layer {}: solid fraction {phi}", r[0]);
+    }
+    // The mean x velocity goes from the bottom wall's side (-V) to the top's (+V); where
+    // in between the shear localises is the packing's choice (here mostly at one wall).
+    let vx: Vec<f64> = rows.iter().map(|r| r[col("velocity_x_m_s")]).collect();
+    assert!(vx[0] < 0.0 && vx[vx.len() - 1] > 0.0 && vx.iter().all(|v| v.abs() < 0.5), "{vx:?}");
+}

@@ -21,14 +21,15 @@
 //! counts the rest. **Fabric**: F = mean of n n over the contacts of free grains (trace 1),
 //! its anisotropy a = 2 (lambda_max - lambda_min) and the major axis' angle from x.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::engine::world::View;
 use crate::physics::contact::{ContactRecord, Partner};
+use crate::observe::stats::{Blocking, Estimate, estimate};
 use crate::physics::dim::Vec2;
 
 /// What the contacts of one step say of the packing inside.
-#[derive(Clone, Copy, Debug, Default, Serialize, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, Serialize, Deserialize, PartialEq)]
 pub struct PackingRow {
     pub time_s: f64,
     /// Contacts touching at least one free grain.
@@ -227,4 +228,50 @@ pub fn grain_contacts(v: &View) -> Vec<u32> {
         }
     }
     n
+}
+
+/// The time averages of the packing rows of an averaging window, each with a 95%
+/// interval from block averages (as the wall stresses'; `summary.json`'s
+/// `shear.packing`).
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct PackingSummary {
+    pub rows: usize,
+    pub sigma_xx_pa: Estimate,
+    pub sigma_xy_pa: Estimate,
+    pub sigma_yx_pa: Estimate,
+    pub sigma_yy_pa: Estimate,
+    pub coordination: Estimate,
+    pub coordination_without_rattlers: Estimate,
+    pub rattlers: Estimate,
+    pub sliding_fraction: Option<Estimate>,
+    pub fabric_xx: Estimate,
+    pub fabric_xy: Estimate,
+    pub fabric_yy: Estimate,
+    pub fabric_anisotropy: Estimate,
+}
+
+/// The summary of `rows` (evenly spaced in time), blocks as `blocking` says; none with
+/// fewer than 4 rows.
+pub fn packing_summary(rows: &[PackingRow], blocking: Blocking) -> Option<PackingSummary> {
+    if rows.len() < 4 {
+        return None;
+    }
+    let interval = (rows[rows.len() - 1].time_s - rows[0].time_s) / (rows.len() - 1) as f64;
+    let est = |f: fn(&PackingRow) -> f64| estimate(&rows.iter().map(f).collect::<Vec<_>>(), blocking, interval);
+    let sliding: Vec<f64> = rows.iter().filter_map(|r| r.sliding_fraction).collect();
+    Some(PackingSummary {
+        rows: rows.len(),
+        sigma_xx_pa: est(|r| r.sigma_xx_pa),
+        sigma_xy_pa: est(|r| r.sigma_xy_pa),
+        sigma_yx_pa: est(|r| r.sigma_yx_pa),
+        sigma_yy_pa: est(|r| r.sigma_yy_pa),
+        coordination: est(|r| r.coordination),
+        coordination_without_rattlers: est(|r| r.coordination_without_rattlers),
+        rattlers: est(|r| r.rattlers as f64),
+        sliding_fraction: (sliding.len() >= 4).then(|| estimate(&sliding, blocking, interval)),
+        fabric_xx: est(|r| r.fabric_xx),
+        fabric_xy: est(|r| r.fabric_xy),
+        fabric_yy: est(|r| r.fabric_yy),
+        fabric_anisotropy: est(|r| r.fabric_anisotropy),
+    })
 }

@@ -103,6 +103,9 @@ pub struct ShearSummary {
     /// earlier stage, a reference code's output, or a packing with no contact.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub mean_overlap_rel: Option<f64>,
+    /// The packing's time averages over the same window (the scene's `output.contacts`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub packing: Option<crate::observe::packing::PackingSummary>,
     /// Why an interval is less than it says: the averaged rows too short for two
     /// automatic blocks of a quantity (its interval then comes from 2 blocks shorter than
     /// 8 autocorrelation times: wide, and still maybe too narrow). None when all hold.
@@ -141,7 +144,7 @@ pub fn stress_estimates(rows: &[WallRow], packing_fraction: Option<f64>, statist
             named.join(", ")
         )
     });
-    ShearSummary { averaged_from_s: kept[0].time_s, shear_stress_pa, normal_stress_pa, stress_ratio, packing_fraction, mean_overlap_rel: None, warning }
+    ShearSummary { averaged_from_s: kept[0].time_s, shear_stress_pa, normal_stress_pa, stress_ratio, packing_fraction, mean_overlap_rel: None, packing: None, warning }
 }
 
 #[cfg(test)]

@@ -263,7 +263,7 @@ impl OutFolder {
     /// Take back the folder of a run that did not complete, to resume it: its manifest
     /// must be grainlab's and its status not `completed`. The status goes back to
     /// `running`, and the files a resumed run writes again at its end (`summary.json`,
-    /// `force_overlap.csv`) and the frames past the first `frames` of `frames_kept` are
+    /// `force_overlap.csv`, `profiles.csv`) and the frames past the first `frames` of `frames_kept` are
     /// deleted and unlisted, so that nothing in the folder mixes the two runs.
     pub fn reopen(dir: &Path, frames_kept: &[String]) -> Result<Self, Error> {
         let refuse = |why: String| Err(Error::Folder { dir: dir.display().to_string(), why });
@@ -273,7 +273,7 @@ impl OutFolder {
         if manifest.status == "completed" {
             return refuse(format!("holds a completed `grainlab {}`: nothing to resume", manifest.command));
         }
-        let gone = |p: &str| p == "summary.json" || p == "force_overlap.csv" || p == "force_overlap.csv.part" || (p.starts_with("frames/") && !frames_kept.iter().any(|f| f == p));
+        let gone = |p: &str| ["summary.json", "force_overlap.csv", "force_overlap.csv.part", "profiles.csv", "profiles.csv.part"].contains(&p) || (p.starts_with("frames/") && !frames_kept.iter().any(|f| f == p));
         for f in manifest.files.iter().filter(|f| gone(&f.path)) {
             remove_if_there(&dir.join(&f.path))?;
         }

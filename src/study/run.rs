@@ -18,6 +18,9 @@ use crate::study::protocol::{Phase, phases};
 use crate::error::Error;
 use crate::observe::energy::energy_summary;
 use crate::observe::impact::ImpactObserver;
+use crate::observe::packing::{PackingRow, packing_row, packing_summary};
+use crate::observe::profiles::{LayerProfile, ProfileSample, layer_count, profile_sample, profile_summary};
+use crate::observe::stats::Blocking;
 use crate::observe::stress::{ShearSummary, WallAverager, WallRow, stress_estimates};
 use crate::output::checkpoint::{CHECKPOINT, Checkpoint};
 use crate::output::csv::CsvSeries;
@@ -194,6 +197,11 @@ struct LoopState {
     energy_bytes: Option<u64>,
     walls_bytes: Option<u64>,
     packing_bytes: Option<u64>,
+    /// The packing rows and the profiles' samples so far (the scene's `output.contacts`),
+    /// and the profiles' number of layers, fixed at the first sample.
+    packing_rows: Vec<PackingRow>,
+    profile_rows: Vec<ProfileSample>,
+    profile_layers: Option<usize>,
     /// The frames written (time, s; file): none when the run writes none (a run that
     /// does has written its first before any checkpoint).
     frames: Vec<(f64, String)>,
@@ -221,7 +229,10 @@ impl LoopState {
     }
 
     /// Record a sample: the energy row and the walls' row (forces averaged since the last).
-    fn sample(&mut self, e: &dyn Engine, out: &mut Outputs, stage: &str, energy_on: bool, length: f64, depth: f64) -> Result<(), Error> {
+    /// Record a sample: energy, walls, and with `inside` (the contacts recorded at this
+    /// step) the packing row and the profiles' sample.
+    #[allow(clippy::too_many_arguments)]
+    fn sample(&mut self, e: &dyn Engine, out: &mut Outputs, stage: &str, energy_on: bool, inside: bool, length: f64, depth: f64) -> Result<(), Error> {
         self.record_energy(e, out, stage, energy_on)?;
         if let Some(row) = self.walls_avg.row(&e.view(), length, depth) {
             if let Some(w) = out.walls.as_mut() {
@@ -229,8 +240,18 @@ impl LoopState {
             }
             self.wall_rows.push(row);
         }
-        if let (Some(s), Some(row)) = (out.packing.as_mut(), crate::observe::packing::packing_row(&e.view(), length, depth)) {
-            s.row_in(stage, &row)?;
+        if inside {
+            let v = e.view();
+            if let Some(row) = packing_row(&v, length, depth) {
+                if let Some(s) = out.packing.as_mut() {
+                    s.row_in(stage, &row)?;
+                }
+                self.packing_rows.push(row);
+            }
+            if let Some(n) = self.profile_layers.or_else(|| layer_count(&v)) {
+                self.profile_layers = Some(n);
+                self.profile_rows.extend(profile_sample(&v, n, length, depth));
+            }
         }
         Ok(())
     }
@@ -304,6 +325,8 @@ fn drive(scene: &Scene, mut built: Built, opts: &RunOptions, resumed: Option<(Ou
     let phases = phases(scene, dt, built.length, built.depth)?;
     let total = phases.last().map_or(0, Phase::last);
     let energy_on = scene.output.energy;
+    // The packing inside: contacts recorded at samples and frames.
+    let inside = scene.output.contacts;
     let now = std::time::SystemTime::now();
     let fresh = resumed.is_none();
     let (mut outputs, mut st) = match resumed {
@@ -414,7 +437,7 @@ fn drive(scene: &Scene, mut built: Built, opts: &RunOptions, resumed: Option<(Ou
             // Whether anything below looks at the grains after this step: else the step's
             // final half kick is left to the next one's drift.
             let look = sample || frame || checkpoint || stopping || st.impact.is_some();
-            if (sample || frame) && scene.output.contacts {
+            if (sample || frame || stopping) && inside {
                 e.want_contacts();
             }
             if let Err(err) = e.advance(look) {
@@ -440,7 +463,7 @@ fn drive(scene: &Scene, mut built: Built, opts: &RunOptions, resumed: Option<(Ou
                 break 'run;
             }
             if sample {
-                or_stop!('run, st.sample(e, &mut outputs, stage, energy_on, length, depth));
+                or_stop!('run, st.sample(e, &mut outputs, stage, energy_on, inside, length, depth));
             }
             if frame {
                 or_stop!('run, outputs.frame(e, scene.output.contacts));
@@ -469,7 +492,7 @@ fn drive(scene: &Scene, mut built: Built, opts: &RunOptions, resumed: Option<(Ou
             }
             if stopping {
                 if !sample {
-                    or_stop!('run, st.sample(e, &mut outputs, stage, energy_on, length, depth));
+                    or_stop!('run, st.sample(e, &mut outputs, stage, energy_on, inside, length, depth));
                 }
                 error = Some(Error::Interrupted { step: e.steps(), time: e.time() });
                 break 'run;
@@ -496,6 +519,15 @@ fn drive(scene: &Scene, mut built: Built, opts: &RunOptions, resumed: Option<(Ou
     let stage_timing = timings.iter().map(|(s, d)| StageTime { stage: s.clone(), seconds: d.as_secs_f64(), share: d.as_secs_f64() / total_t }).collect();
     let mut stages = Vec::new();
     let mut shear = None;
+    // The profiles of the last averaged stretch (profiles.csv), with the free grains'
+    // mean diameter and density for the inertial number.
+    let mut profiles: Option<Vec<LayerProfile>> = None;
+    let (diameter, density) = {
+        let p = e.particles();
+        let n = p.n_free.max(1) as f64;
+        let volume: f64 = (0..p.n_free).map(|i| p.m[i] / scene.materials[p.material[i] as usize].density).sum();
+        (2.0 * p.r[..p.n_free].iter().sum::<f64>() / n, p.m[..p.n_free].iter().sum::<f64>() / volume)
+    };
     let mut from = 0;
     for (phase, &to) in phases.iter().zip(&st.stage_ends) {
         let rows = &st.wall_rows[from..to];
@@ -504,6 +536,16 @@ fn drive(scene: &Scene, mut built: Built, opts: &RunOptions, resumed: Option<(Ou
         if let Some(a) = averaged.as_mut().filter(|_| to == st.wall_rows.len()) {
             let p = e.particles();
             a.mean_overlap_rel = crate::kernels::cells::mean_overlap(&p.x, &p.r, p.n_free, &e.boundary()).map(|m| m.0);
+        }
+        let blocking = Blocking::from(scene.statistics.blocks);
+        if let Some(a) = averaged.as_mut() {
+            // The packing's rows and profiles over the walls' averaging window.
+            let end = rows.last().map_or(f64::INFINITY, |r| r.time_s);
+            let within = |t: f64| t >= a.averaged_from_s && t <= end;
+            let kept: Vec<PackingRow> = st.packing_rows.iter().filter(|r| within(r.time_s)).copied().collect();
+            a.packing = packing_summary(&kept, blocking);
+            let samples: Vec<ProfileSample> = st.profile_rows.iter().filter(|r| within(r.time_s)).cloned().collect();
+            profiles = profile_summary(&samples, blocking, diameter, density).or(profiles);
         }
         if averaged.is_some() {
             shear.clone_from(&averaged);
@@ -567,6 +609,9 @@ fn drive(scene: &Scene, mut built: Built, opts: &RunOptions, resumed: Option<(Ou
         }
         if let Some(o) = st.impact.as_ref() {
             or_note!("force_overlap.csv", folder.write_series("force_overlap.csv", &o.curve));
+        }
+        if let Some(rows) = &profiles {
+            or_note!("profiles.csv", folder.write_series("profiles.csv", rows));
         }
         // A completed run has nothing to resume: its checkpoint goes.
         if error.is_none() {
