@@ -14,6 +14,10 @@ use crate::physics::particles::Particles;
 use crate::physics::walls::Wall;
 use crate::scene::{Analysis, Scene, TangentialSpec};
 
+/// bench-peers' variant with the observers inside the packing on (its name in
+/// docs/effect-costs.json).
+const INSIDE_VARIANT: &str = "inside the packing on (output.contacts, a sample per 50 steps)";
+
 /// One effect: whether it is on, and why.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct Effect {
@@ -125,6 +129,13 @@ impl Effects {
         push("impact observer", impact, format!("declared: analysis = {}", scene.analysis.name()), None);
         let stresses = scene.walls.is_some();
         push("wall stresses (averaged per sample)", stresses, if stresses { "derived: the scene has walls".into() } else { "derived: no walls".into() }, None);
+        let inside = scene.output.contacts;
+        push(
+            "packing observers (contacts, profiles)",
+            inside,
+            format!("declared: output.contacts = {inside}{}", if inside { "" } else { " (the default): no recording stage" }),
+            Some(INSIDE_VARIANT),
+        );
         let frames = scene.output.frames;
         push("ParaView frames", frames > 0, format!("declared: output.frames = {frames}"), None);
         push("watchdog (overlaps, finite state)", true, "always".into(), None);
