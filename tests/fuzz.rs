@@ -12,6 +12,8 @@
 //! (`.ci/run`). A failure prints the case (base, mutations, seed, broken text) that
 //! reproduces it: `FUZZ_CASE=2,1,9139556803309287229,2 cargo test --test fuzz`.
 
+mod common;
+
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::path::Path;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -282,7 +284,14 @@ fn assert_files_finite(dir: &Path) {
         }
     }
     for f in files {
-        assert_finite_text(&f.display().to_string(), &std::fs::read_to_string(&f).unwrap());
+        if f.extension().is_some_and(|e| e == "vtp") {
+            // Binary arrays: every value read back.
+            for (name, values) in common::read_vtp(&f) {
+                assert!(values.iter().all(|v| v.is_finite()), "{}: {name} holds a number that is not finite", f.display());
+            }
+        } else {
+            assert_finite_text(&f.display().to_string(), &std::fs::read_to_string(&f).unwrap());
+        }
     }
 }
 
