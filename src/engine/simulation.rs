@@ -152,6 +152,8 @@ pub trait Engine: Send {
     fn want_contacts(&mut self);
     /// The contacts of the last step that recorded them, and that step (0: none).
     fn contacts(&self) -> (&[ContactRecord], u64);
+    /// The last record in full: the contacts and the state they were computed from.
+    fn probe(&self) -> &crate::engine::world::Probe;
     /// A read-only view of the state, what observers and outputs read: the contacts are
     /// there when they are of this very step.
     fn view(&self) -> View<'_> {
@@ -224,5 +226,8 @@ impl<L: ContactLaw> Engine for Simulation<L> {
     }
     fn contacts(&self) -> (&[ContactRecord], u64) {
         (&self.world.probe.contacts, self.world.probe.step)
+    }
+    fn probe(&self) -> &crate::engine::world::Probe {
+        &self.world.probe
     }
 }

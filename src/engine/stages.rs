@@ -240,6 +240,9 @@ impl<Dm: Damping, T: Tangential, const SPIN: bool> Stage<ContactModel<Dm, T>> fo
         }
         let mut out = std::mem::take(&mut w.probe.contacts);
         out.clear();
+        let pr = &mut w.probe;
+        (pr.x.clone_from(&w.p.x), pr.v.clone_from(&w.p.v), pr.omega.clone_from(&w.p.omega));
+        pr.walls = w.walls.iter().map(|wall| (wall.contact_surface(), wall.v)).collect();
         let view = PairView { p: &w.p, boundary: w.boundary, law: w.law, pair_table: &w.pair_table, dt: w.dt };
         for (k, &[i, j]) in w.pairs.pairs.checked().pairs().iter().enumerate() {
             if let Some(c) = record_pair::<Dm, T, SPIN>(&view, (i as usize, j as usize), &w.pairs.consts[k], &w.pairs.hist[k]) {
@@ -274,11 +277,12 @@ impl<Dm: Damping, T: Tangential, const SPIN: bool> Stage<ContactModel<Dm, T>> fo
                     point: p.x[i] - n * gap,
                     normal_force: c.normal,
                     tangential_force: c.tangential.elastic + c.tangential.damping,
+                    tangential_elastic: c.tangential.elastic,
                     sliding: c.tangential.slip_energy > 0.0,
                 });
             }
         }
-        w.probe = crate::engine::world::Probe { wanted: false, contacts: out, step: w.step };
+        (w.probe.wanted, w.probe.contacts, w.probe.step) = (false, out, w.step);
         Ok(())
     }
 }

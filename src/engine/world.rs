@@ -69,6 +69,14 @@ pub struct Probe {
     pub contacts: Vec<ContactRecord>,
     /// The step the contacts are of (0: none recorded yet).
     pub step: u64,
+    /// What the contact stages computed them from: every grain's position, velocity and
+    /// spin, and each wall's contact surface height and velocity, as they were then
+    /// (a frame's state is the step's end; the contacts see the velocities half a kick
+    /// before it). The frozen-state cross-checks give these to the reference codes.
+    pub x: Vec<crate::physics::dim::Vec2>,
+    pub v: Vec<crate::physics::dim::Vec2>,
+    pub omega: Vec<f64>,
+    pub walls: Vec<(f64, crate::physics::dim::Vec2)>,
 }
 
 impl<L: ContactLaw> World<L> {

@@ -213,6 +213,7 @@ pub fn record_pair<Dm: Damping, T: Tangential, const SPIN: bool>(w: &PairView<'_
         point: p.x[i] - n * (ri - 0.5 * dn),
         normal_force: c.normal,
         tangential_force: c.tangential.elastic + c.tangential.damping,
+        tangential_elastic: c.tangential.elastic,
         sliding: c.tangential.slip_energy > 0.0,
     })
 }

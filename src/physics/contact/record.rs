@@ -32,6 +32,10 @@ pub struct ContactRecord {
     pub normal_force: f64,
     /// Tangential force on grain i (elastic and viscous), N.
     pub tangential_force: Vec2,
+    /// Its elastic part (after the Coulomb cap), N: what the contact's tangential state
+    /// holds after this step (`-kt xi` for a total displacement xi, the incremental
+    /// elastic force itself); the frozen-state cross-checks hand it to the reference codes.
+    pub tangential_elastic: Vec2,
     /// The contact slid at this step: its elastic tangential force was cut to the
     /// Coulomb cap mu |Fn|.
     pub sliding: bool,
