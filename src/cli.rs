@@ -100,6 +100,21 @@ enum Command {
         #[arg(long, conflicts_with_all = ["scene", "out", "bench"])]
         explain_fields: bool,
     },
+    /// Run a shear cell for --steps steps and write the state its last step's contacts
+    /// were computed from (scene.txt, grains.txt, history.txt) and those contacts
+    /// (contacts.txt), for the reference codes to evaluate without moving
+    /// (scripts/frozen/, src/workbench/frozen.rs).
+    Freeze {
+        scene: String,
+        #[arg(long)]
+        steps: u64,
+        /// Output folder: new, empty, or one grainlab wrote (see --overwrite).
+        #[arg(long)]
+        out: PathBuf,
+        /// Delete the files an earlier grainlab command wrote in --out first.
+        #[arg(long)]
+        overwrite: bool,
+    },
     /// Write the workbench cases (scene, case.json, decks) under a root folder.
     Cases {
         #[arg(long, default_value = "reference/cases")]
@@ -323,6 +338,17 @@ fn execute(cli: Cli) -> Result<(), Error> {
                 say!("{}", out.join(name).display())?;
             }
             folder.finish("completed")
+        }
+        Command::Freeze { scene, steps, out, overwrite } => {
+            let scene = load_scene(&scene)?;
+            grainlab::error::check_option(steps >= 1, "--steps", steps, ">= 1")?;
+            let f = grainlab::workbench::frozen::freeze(&scene, steps)?;
+            let mut folder = OutFolder::claim(&out, overwrite, &format!("freeze {}", scene.name))?;
+            for (name, text) in [("scene.txt", &f.scene_txt), ("grains.txt", &f.grains_txt), ("history.txt", &f.history_txt), ("contacts.txt", &f.contacts_txt)] {
+                folder.write(name, text.as_bytes())?;
+            }
+            folder.finish("completed")?;
+            say!("{}: {} contacts at step {steps}", out.display(), f.contacts.len())
         }
         Command::Cases { root, filter } => {
             let n = grainlab::workbench::write_cases(&root, filter.as_deref())?;

@@ -40,10 +40,14 @@
 //!    one built from the same scene, for an exact restart ([`engine::snapshot`]).
 //! 5. **Observers** ([`observe`]): impacts ([`observe::impact`]), wall stresses
 //!    ([`observe::stress`]), the energy balance's summary ([`observe::energy`]),
-//!    block-averaged confidence intervals ([`observe::stats`]), each from a [`View`].
+//!    block-averaged confidence intervals ([`observe::stats`]), the packing inside from
+//!    the contacts a step records (stress tensor, coordination, fabric:
+//!    [`observe::packing`]) and its profiles across the gap ([`observe::profiles`]),
+//!    each from a [`View`].
 //! 6. **Output** ([`output`]): only finite numbers ([`finite`]; an undefined quantity is
 //!    empty or `null`): `summary.json` ([`output::summary`]), CSV time series with
-//!    unit-suffixed headers, ParaView `.vtp` frames with a `.pvd` index, in an output
+//!    unit-suffixed headers, ParaView `.vtp` frames (binary; grains, and the contacts as
+//!    force-chain lines) with `.pvd` indexes, in an output
 //!    folder that is grainlab's ([`output::folder`]: a manifest, files that appear whole),
 //!    with the scene as it ran and what produced the run ([`output::provenance`]), and
 //!    the checkpoint a run resumes from ([`output::checkpoint`]: versioned, checksummed).
@@ -57,7 +61,8 @@
 //!    ([`workbench::cases`](mod@workbench::cases)), the digest of LIGGGHTS' and YADE's output with the engine's
 //!    own observers ([`workbench::digest`](mod@workbench::digest)), the comparison ([`workbench::compare`]); the
 //!    exporter writes any scene as a deck for either code, exactly or refused by name
-//!    ([`workbench::export`]).
+//!    ([`workbench::export`]); frozen states the codes evaluate without moving, to
+//!    check what the packing observers read ([`workbench::frozen`]).
 //!
 //! Each class of failure has its exit code ([`error::exit`]). Everything is SI: m, kg,
 //! s, N, Pa, J.

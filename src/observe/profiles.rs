@@ -5,11 +5,11 @@
 //! - the mean x and y velocity (mass-weighted, grains by their centre), m/s;
 //! - the solid fraction: the disks' area inside the layer (each disk cut exactly by the
 //!   layer's lines) over the layer's area;
-//! - the granular temperature T = (<|v - <v>|^2>) / 2, m^2/s^2 (mass-weighted, about the
+//! - the granular temperature `T = <|v - <v>|^2> / 2`, m^2/s^2 (mass-weighted, about the
 //!   layer's mean velocity; per degree of freedom of the plane);
 //! - the stress tensor, Pa, tension positive: the grains' stress times volume
 //!   ([`crate::observe::packing::grain_stress_volumes`], by centre) less
-//!   m (v - <v>)(v - <v>), over the layer's volume L_x t h.
+//!   `m (v - <v>)(v - <v>)`, over the layer's volume L_x t h.
 //!
 //! [`profile_summary`] averages each over the samples of an averaging window with a 95%
 //! interval from block averages, and derives each layer's shear rate (the centred
@@ -139,7 +139,7 @@ pub struct LayerProfile {
     pub sigma_yx_pa_ci95: f64,
     pub sigma_yy_pa: f64,
     pub sigma_yy_pa_ci95: f64,
-    /// d<vx>/dy, 1/s: centred differences of the mean x velocity (one-sided at the walls).
+    /// `d<vx>/dy`, 1/s: centred differences of the mean x velocity (one-sided at the walls).
     pub shear_rate_1_s: f64,
     /// -(sigma_xx + sigma_yy) / 2, Pa.
     pub pressure_pa: f64,

@@ -16,6 +16,7 @@ pub mod cases;
 pub mod compare;
 pub mod digest;
 pub mod export;
+pub mod frozen;
 
 pub use cases::*;
 pub use compare::*;
