@@ -368,3 +368,15 @@ fn a_run_reports_progress_lines_and_a_headline() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(!err.contains("% of ") && err.contains("shear: completed;"), "{err}");
 }
+
+#[test]
+fn freeze_refuses_what_the_reference_decks_cannot_load_by_field() {
+    // The built-in shear cell has rough walls and a loaded top wall: a frozen state of it
+    // could not be loaded as LIGGGHTS' primitive planes, so it is refused by name, and
+    // nothing is written.
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("f");
+    grainlab().args(["freeze", "shear", "--steps", "10", "--out", out.to_str().unwrap()]).assert().code(2).stderr(predicate::str::contains("walls.bottom.surface"));
+    assert!(!out.exists());
+    grainlab().args(["freeze", "shear", "--steps", "0", "--out", out.to_str().unwrap()]).assert().code(2).stderr(predicate::str::contains("--steps"));
+}
