@@ -215,3 +215,17 @@ fn the_summary_and_the_profiles_balance_the_walls_across_the_gap() {
     let vx: Vec<f64> = rows.iter().map(|r| r[col("velocity_x_m_s")]).collect();
     assert!(vx[0] < 0.0 && vx[vx.len() - 1] > 0.0 && vx.iter().all(|v| v.abs() < 0.5), "{vx:?}");
 }
+
+#[test]
+fn the_packing_observers_memory_is_estimated_before_anything_runs() {
+    // Each kept sample holds a profile of up to MAX_PROFILE_LAYERS layers: a scene that
+    // asks for contacts at very many samples is refused by the budget, naming the field
+    // (before the engine is built), and runs with the observers off.
+    let mut scene = grainlab::scene::builtin::shear_cell(300, 0.012);
+    scene.output.samples = 100_000;
+    let limits = grainlab::scene::limits::Limits::with_memory(1 << 30);
+    assert!(grainlab::study::accuracy::build_limited(&scene, 1, &limits).is_ok());
+    scene.output.contacts = true;
+    let msg = grainlab::study::accuracy::build_limited(&scene, 1, &limits).err().expect("over budget").to_string();
+    assert!(msg.contains("output.contacts") && msg.contains("packing observers"), "{msg}");
+}

@@ -330,6 +330,9 @@ pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<B
         (samples, "output.samples".to_string(), scene.output.samples.to_string())
     };
     estimate.rows = (rows as u64, field, value);
+    if scene.output.contacts {
+        estimate.inside = (p.len() as u64, samples as u64);
+    }
     limits.check(&estimate)?;
     consistency::motion(&p, &walls, Vec2::from(scene.gravity), &names, dt)?;
     consistency::load(scene, &p, &walls, length, depth, dt)?;

@@ -22,6 +22,7 @@ use serde::{Deserialize, Serialize};
 use crate::engine::world::View;
 use crate::observe::packing::grain_stress_volumes;
 use crate::observe::stats::{Blocking, Estimate, estimate};
+use crate::scene::limits::MAX_PROFILE_LAYERS;
 
 /// The layers of one sample: their bounds and values.
 #[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
@@ -39,7 +40,8 @@ pub struct ProfileSample {
 pub const QUANTITIES: [&str; 8] = ["velocity_x_m_s", "velocity_y_m_s", "solid_fraction", "granular_temperature_m2_s2", "sigma_xx_pa", "sigma_xy_pa", "sigma_yx_pa", "sigma_yy_pa"];
 
 /// The number of layers for the gap between `v`'s walls: about one mean free-grain
-/// diameter each, at least 1; none without two walls or free grains.
+/// diameter each, at least 1, at most [`MAX_PROFILE_LAYERS`] (the memory estimate's
+/// bound); none without two walls or free grains.
 pub fn layer_count(v: &View) -> Option<usize> {
     let p = v.particles;
     if v.walls.len() != 2 || p.n_free == 0 {
@@ -47,7 +49,7 @@ pub fn layer_count(v: &View) -> Option<usize> {
     }
     let d = 2.0 * p.r[..p.n_free].iter().sum::<f64>() / p.n_free as f64;
     let gap = v.walls[1].contact_surface() - v.walls[0].contact_surface();
-    (gap > 0.0 && d > 0.0).then(|| ((gap / d).round() as usize).clamp(1, p.n_free))
+    (gap > 0.0 && d > 0.0).then(|| ((gap / d).round().min(MAX_PROFILE_LAYERS as f64) as usize).clamp(1, p.n_free))
 }
 
 /// The area of a disk of radius `r` below the line `u` above its centre, m^2.

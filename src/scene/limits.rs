@@ -24,6 +24,21 @@ pub const BYTES_PER_MATERIAL_PAIR: u64 = 56;
 /// impact's force-overlap curve (3 f64), rounded up.
 pub const BYTES_PER_ROW: u64 = 96;
 
+/// Bytes per grain of the packing observers (`output.contacts`), on top of
+/// [`BYTES_PER_GRAIN`]: a step's contact records (88 bytes each, about 1.5 contacts per
+/// grain in a dense packing, up to 3 in 2D), the copies of the state they were computed
+/// from (40), and a frame's contact lines and CSV being written (about 380 bytes per
+/// contact).
+pub const BYTES_PER_GRAIN_CONTACTS: u64 = 1536;
+
+/// Most layers of a profile across the gap ([`crate::observe::profiles`]): a gap of more
+/// than this many mean diameters gets thicker layers.
+pub const MAX_PROFILE_LAYERS: usize = 1000;
+
+/// Bytes per sample the packing observers keep for the summary: a packing row and a
+/// profile sample of at most [`MAX_PROFILE_LAYERS`] layers of 8 numbers.
+pub const BYTES_PER_PACKING_SAMPLE: u64 = 256 + 64 * MAX_PROFILE_LAYERS as u64;
+
 /// Most materials a scene may list: the pair table has one entry per ordered pair, and
 /// the LIGGGHTS export writes n x n matrices on one line.
 pub const MAX_MATERIALS: usize = 256;
@@ -122,15 +137,19 @@ pub struct MemoryEstimate {
     /// Rows kept for the summary (wall rows, impact curve points), and the field that
     /// sets them.
     pub rows: (u64, String, String),
+    /// With the packing observers (`output.contacts`): the grains whose contacts are
+    /// recorded and the samples kept.
+    pub inside: (u64, u64),
 }
 
 impl MemoryEstimate {
-    fn terms(&self) -> [(u64, &str); 4] {
+    fn terms(&self) -> [(u64, &str); 5] {
         [
             (self.grains.0.saturating_mul(BYTES_PER_GRAIN), "grains"),
             (self.wall_grains.0.saturating_mul(BYTES_PER_GRAIN), "wall grains"),
             (self.materials.saturating_mul(self.materials).saturating_mul(BYTES_PER_MATERIAL_PAIR), "material pairs"),
             (self.rows.0.saturating_mul(BYTES_PER_ROW), "rows"),
+            (self.inside.0.saturating_mul(BYTES_PER_GRAIN_CONTACTS).saturating_add(self.inside.1.saturating_mul(BYTES_PER_PACKING_SAMPLE)), "the packing observers (output.contacts)"),
         ]
     }
     /// The total, bytes.
@@ -149,7 +168,8 @@ impl MemoryEstimate {
             0 => (self.grains.1.clone(), self.grains.2.clone()),
             1 => (self.wall_grains.1.clone(), self.wall_grains.2.clone()),
             2 => ("materials".into(), format!("{} materials", self.materials)),
-            _ => (self.rows.1.clone(), self.rows.2.clone()),
+            3 => (self.rows.1.clone(), self.rows.2.clone()),
+            _ => ("output.contacts".into(), format!("true ({} grains, {} samples)", self.inside.0, self.inside.1)),
         }
     }
 }
@@ -246,6 +266,7 @@ mod tests {
             wall_grains: (10, "walls.bottom.surface.rough.radius".into(), "0.001".into()),
             materials: 1,
             rows: (400, "output.samples".into(), "400".into()),
+            inside: (0, 0),
         };
         assert_eq!(e.bytes(), (1 << 20) * BYTES_PER_GRAIN + 10 * BYTES_PER_GRAIN + BYTES_PER_MATERIAL_PAIR + 400 * BYTES_PER_ROW);
         assert!(Limits::with_memory(2 << 30).check(&e).is_ok());
