@@ -11,34 +11,27 @@ import os
 BEYOND_CAP = 1 + 1e-5
 
 
+def lines(d, name):
+    """The words of each line of DIR/name that holds any, comments ('#' on) left out."""
+    with open(os.path.join(d, name)) as f:
+        for line in f:
+            w = line.split("#")[0].split()
+            if w:
+                yield w
+
+
 def scene(d):
-    out = {}
-    for line in open(os.path.join(d, "scene.txt")):
-        w = line.split("#")[0].split()
-        if w:
-            out[w[0]] = float(w[1])
-    return out
+    return {w[0]: float(w[1]) for w in lines(d, "scene.txt")}
 
 
 def grains(d):
     """id -> (x, y, r, vx, vy, omega)."""
-    g = {}
-    for line in open(os.path.join(d, "grains.txt")):
-        w = line.split("#")[0].split()
-        if w:
-            g[int(w[0])] = tuple(float(v) for v in w[1:7])
-    return g
+    return {int(w[0]): tuple(float(v) for v in w[1:7]) for w in lines(d, "grains.txt")}
 
 
 def history(d):
     """(i, j) -> (ft_x, ft_y, sliding): j an int, or 'bottom' / 'top'."""
-    h = {}
-    for line in open(os.path.join(d, "history.txt")):
-        w = line.split("#")[0].split()
-        if w:
-            j = w[1] if w[1] in ("bottom", "top") else int(w[1])
-            h[(int(w[0]), j)] = (float(w[2]), float(w[3]), w[4] == "1")
-    return h
+    return {(int(w[0]), w[1] if w[1] in ("bottom", "top") else int(w[1])): (float(w[2]), float(w[3]), w[4] == "1") for w in lines(d, "history.txt")}
 
 
 def handed_over(ft, sliding):

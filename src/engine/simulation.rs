@@ -7,7 +7,7 @@ use std::time::{Duration, Instant};
 use crate::engine::world::{MotionChange, Stage, View, World};
 use crate::error::Error;
 use crate::physics::boundary::Boundary;
-use crate::physics::contact::{ContactLaw, ContactRecord};
+use crate::physics::contact::ContactLaw;
 use crate::physics::energy::EnergyRow;
 use crate::physics::particles::Particles;
 use crate::physics::walls::Wall;
@@ -150,15 +150,14 @@ pub trait Engine: Send {
     /// Ask for the contacts of the next step (recorded only where the scene's
     /// `output.contacts` put the `RecordContacts` stage in the pipeline).
     fn want_contacts(&mut self);
-    /// The contacts of the last step that recorded them, and that step (0: none).
-    fn contacts(&self) -> (&[ContactRecord], u64);
-    /// The last record in full: the contacts and the state they were computed from.
+    /// The last record of the contacts: the step it is of (0: none), the contacts, and
+    /// the state they were computed from.
     fn probe(&self) -> &crate::engine::world::Probe;
     /// A read-only view of the state, what observers and outputs read: the contacts are
     /// there when they are of this very step.
     fn view(&self) -> View<'_> {
-        let (contacts, at) = self.contacts();
-        let contacts = if at == self.steps() && at > 0 { contacts } else { &[] };
+        let probe = self.probe();
+        let contacts = if probe.step == self.steps() && probe.step > 0 { &probe.contacts[..] } else { &[] };
         View { particles: self.particles(), contacts, walls: self.walls(), boundary: self.boundary(), time: self.time() }
     }
 }
@@ -223,9 +222,6 @@ impl<L: ContactLaw> Engine for Simulation<L> {
     }
     fn want_contacts(&mut self) {
         self.world.probe.wanted = true;
-    }
-    fn contacts(&self) -> (&[ContactRecord], u64) {
-        (&self.world.probe.contacts, self.world.probe.step)
     }
     fn probe(&self) -> &crate::engine::world::Probe {
         &self.world.probe

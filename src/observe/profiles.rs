@@ -39,6 +39,11 @@ pub struct ProfileSample {
 /// The quantities of a layer, in [`ProfileSample::layers`]' order, with their units.
 pub const QUANTITIES: [&str; 8] = ["velocity_x_m_s", "velocity_y_m_s", "solid_fraction", "granular_temperature_m2_s2", "sigma_xx_pa", "sigma_xy_pa", "sigma_yx_pa", "sigma_yy_pa"];
 
+/// The free grains' mean diameter, m (0 without free grains).
+pub fn mean_diameter(p: &crate::physics::particles::Particles) -> f64 {
+    if p.n_free == 0 { 0.0 } else { 2.0 * p.r[..p.n_free].iter().sum::<f64>() / p.n_free as f64 }
+}
+
 /// The number of layers for the gap between `v`'s walls: about one mean free-grain
 /// diameter each, at least 1, at most [`MAX_PROFILE_LAYERS`] (the memory estimate's
 /// bound); none without two walls or free grains.
@@ -47,7 +52,7 @@ pub fn layer_count(v: &View) -> Option<usize> {
     if v.walls.len() != 2 || p.n_free == 0 {
         return None;
     }
-    let d = 2.0 * p.r[..p.n_free].iter().sum::<f64>() / p.n_free as f64;
+    let d = mean_diameter(p);
     let gap = v.walls[1].contact_surface() - v.walls[0].contact_surface();
     (gap > 0.0 && d > 0.0).then(|| ((gap / d).round().min(MAX_PROFILE_LAYERS as f64) as usize).clamp(1, p.n_free))
 }

@@ -19,7 +19,7 @@ use crate::error::Error;
 use crate::observe::energy::energy_summary;
 use crate::observe::impact::ImpactObserver;
 use crate::observe::packing::{PackingRow, packing_row, packing_summary};
-use crate::observe::profiles::{LayerProfile, ProfileSample, layer_count, profile_sample, profile_summary};
+use crate::observe::profiles::{LayerProfile, ProfileSample, layer_count, mean_diameter, profile_sample, profile_summary};
 use crate::observe::stats::Blocking;
 use crate::observe::stress::{ShearSummary, WallAverager, WallRow, stress_estimates};
 use crate::output::checkpoint::{CHECKPOINT, Checkpoint};
@@ -228,9 +228,9 @@ impl LoopState {
         Ok(())
     }
 
-    /// Record a sample: the energy row and the walls' row (forces averaged since the last).
-    /// Record a sample: energy, walls, and with `inside` (the contacts recorded at this
-    /// step) the packing row and the profiles' sample.
+    /// Record a sample: the energy row, the walls' row (forces averaged since the last),
+    /// and with `inside` (the contacts recorded at this step) the packing row and the
+    /// profiles' sample.
     #[allow(clippy::too_many_arguments)]
     fn sample(&mut self, e: &dyn Engine, out: &mut Outputs, stage: &str, energy_on: bool, inside: bool, length: f64, depth: f64) -> Result<(), Error> {
         self.record_energy(e, out, stage, energy_on)?;
@@ -345,7 +345,7 @@ fn drive(scene: &Scene, mut built: Built, opts: &RunOptions, resumed: Option<(Ou
                 }
                 if !built.engine.walls().is_empty() {
                     outputs.walls = Some(folder.series("walls.csv")?);
-                    if scene.output.contacts {
+                    if inside {
                         outputs.packing = Some(folder.series("packing.csv")?);
                     }
                 }
@@ -466,7 +466,7 @@ fn drive(scene: &Scene, mut built: Built, opts: &RunOptions, resumed: Option<(Ou
                 or_stop!('run, st.sample(e, &mut outputs, stage, energy_on, inside, length, depth));
             }
             if frame {
-                or_stop!('run, outputs.frame(e, scene.output.contacts));
+                or_stop!('run, outputs.frame(e, inside));
             }
             if j == phase.steps {
                 st.stage_ends.push(st.wall_rows.len());
@@ -524,10 +524,10 @@ fn drive(scene: &Scene, mut built: Built, opts: &RunOptions, resumed: Option<(Ou
     let mut profiles: Option<Vec<LayerProfile>> = None;
     let (diameter, density) = {
         let p = e.particles();
-        let n = p.n_free.max(1) as f64;
         let volume: f64 = (0..p.n_free).map(|i| p.m[i] / scene.materials[p.material[i] as usize].density).sum();
-        (2.0 * p.r[..p.n_free].iter().sum::<f64>() / n, p.m[..p.n_free].iter().sum::<f64>() / volume)
+        (mean_diameter(p), p.m[..p.n_free].iter().sum::<f64>() / volume)
     };
+    let blocking = Blocking::from(scene.statistics.blocks);
     let mut from = 0;
     for (phase, &to) in phases.iter().zip(&st.stage_ends) {
         let rows = &st.wall_rows[from..to];
@@ -537,7 +537,6 @@ fn drive(scene: &Scene, mut built: Built, opts: &RunOptions, resumed: Option<(Ou
             let p = e.particles();
             a.mean_overlap_rel = crate::kernels::cells::mean_overlap(&p.x, &p.r, p.n_free, &e.boundary()).map(|m| m.0);
         }
-        let blocking = Blocking::from(scene.statistics.blocks);
         if let Some(a) = averaged.as_mut() {
             // The packing's rows and profiles over the walls' averaging window.
             let end = rows.last().map_or(f64::INFINITY, |r| r.time_s);

@@ -24,7 +24,6 @@ use std::fmt::Write as _;
 use crate::error::Error;
 use crate::observe::packing::{PackingRow, packing_row};
 use crate::physics::contact::{ContactRecord, Partner};
-use crate::physics::walls::Control;
 use crate::physics::dim::GrainShape;
 use crate::scene::Scene;
 
@@ -76,15 +75,12 @@ pub fn contacts_table(contacts: &[ContactRecord]) -> String {
             },
             _ => *c,
         };
-        let n = -c.normal;
-        let (fn_, ft) = (c.normal * c.normal_force, c.tangential_force);
-        let i = c.i as usize;
-        let point = c.point;
+        let (n, fn_, ft) = (-c.normal, c.normal * c.normal_force, c.tangential_force);
         let (wall, j) = match c.partner {
             Partner::Grain(j) => (false, j),
             Partner::Wall(k) => (true, k),
         };
-        let line = format!("{} {} {:e} {:e} {:e} {:e} {:e} {:e} {:e} {:e} {:e}", i + 1, partner(c.partner), point.x, point.y, n.x, n.y, c.overlap, fn_.x, fn_.y, ft.x, ft.y);
+        let line = format!("{} {} {:e} {:e} {:e} {:e} {:e} {:e} {:e} {:e} {:e}", c.i + 1, partner(c.partner), c.point.x, c.point.y, n.x, n.y, c.overlap, fn_.x, fn_.y, ft.x, ft.y);
         rows.push((wall, c.i, j, line));
     }
     rows.sort_by_key(|r| (r.0, r.1, r.2));
@@ -134,9 +130,6 @@ pub fn freeze(scene: &Scene, steps: u64) -> Result<Frozen, Error> {
     let p = e.particles();
     if probe.step != steps || probe.walls.len() != 2 {
         return Err(Error::Other("frozen-state export: no contacts recorded at the last step".into()));
-    }
-    if e.walls().iter().any(|w| !matches!(w.control, Control::Fixed)) {
-        return Err(refuse("walls", "walls held in y"));
     }
     let m = &scene.materials[0];
     let mut s = String::new();

@@ -26,7 +26,8 @@ pub struct ContactRecord {
     /// From the partner's centre (minimum image) to grain i's centre, m; for a flat wall,
     /// from the contact point to grain i's centre.
     pub branch: Vec2,
-    /// The contact point, m: on the line of centres, in the middle of the overlap.
+    /// The contact point, m: between grains on the line of centres, in the middle of the
+    /// overlap; with a flat wall, on the wall's plane.
     pub point: Vec2,
     /// Normal force along `normal`, N (positive: repulsive).
     pub normal_force: f64,
