@@ -241,7 +241,9 @@ impl<Dm: Damping, T: Tangential, const SPIN: bool> Stage<ContactModel<Dm, T>> fo
         let mut out = std::mem::take(&mut w.probe.contacts);
         out.clear();
         let pr = &mut w.probe;
-        (pr.x.clone_from(&w.p.x), pr.v.clone_from(&w.p.v), pr.omega.clone_from(&w.p.omega));
+        pr.x.clone_from(&w.p.x);
+        pr.v.clone_from(&w.p.v);
+        pr.omega.clone_from(&w.p.omega);
         pr.walls = w.walls.iter().map(|wall| (wall.contact_surface(), wall.v)).collect();
         let view = PairView { p: &w.p, boundary: w.boundary, law: w.law, pair_table: &w.pair_table, dt: w.dt };
         for (k, &[i, j]) in w.pairs.pairs.checked().pairs().iter().enumerate() {

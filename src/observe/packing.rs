@@ -4,8 +4,8 @@
 //!
 //! **Stress** (tension positive, as LAMMPS' `stress/atom` and YADE's `getStress`): the
 //! mean over the free grains' region of the grains' stresses,
-//! sigma_ab = (1/V) [sum over grains p, contacts c of p: (x_c - x_p)_a f_c,b
-//! - sum over grains p: m_p v'_a v'_b], with v' a grain's velocity less the free grains'
+//! sigma_ab = (1/V) [sum over grains p, contacts c of p: (x_c - x_p)_a f_c,b minus
+//! sum over grains p: m_p v'_a v'_b], with v' a grain's velocity less the free grains'
 //! mean (the kinetic part). A grain-grain contact adds -l_a f_b (l from j to i, f on i),
 //! whatever its contact point; a contact with a wall (flat, or a grain glued to a rough
 //! wall) adds (x_c - x_i)_a f_b. The volume V = L_x t H, with t the scene's depth (the
