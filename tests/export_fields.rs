@@ -446,6 +446,22 @@ fn bases(dir: &Path) -> Vec<Base> {
     out.push(focus("file", &s, &["grains.file"]));
 
     // Variants that hold the other enum variants and options, each a change of one leaf.
+    // The linear spring: derived from a characteristic velocity (any grains), and given
+    // (written for the two equal grains; refused where a pair of materials meets at two
+    // reduced masses, as the packing's grains of several sizes do).
+    // The default normal law, written out (written scenes leave it out).
+    let mut hertz = json_of(&collision);
+    hertz["model"]["normal"] = json!("hertz");
+    out.push(Base { name: "collision-hertz", scene: hertz, only: &["model.normal"], variant_of: None });
+    let mut s = collision.clone();
+    s.model.normal = NormalLaw::Hooke { characteristic_velocity: 1.0 };
+    out.push(variant("collision-hooke", &s, "collision", "model.normal", &["model.normal"]));
+    let mut s = collision.clone();
+    s.model.normal = NormalLaw::HookeStiffness { kn: 2e5, kt: 1e5 };
+    out.push(variant("collision-spring", &s, "collision", "model.normal", &["model.normal"]));
+    let mut s = shear.clone();
+    s.model.normal = NormalLaw::HookeStiffness { kn: 2e5, kt: 1e5 };
+    out.push(variant("shear-spring", &s, "shear", "model.normal", &["model.normal"]));
     let mut s = collision.clone();
     s.model.general_damping = Some(0.1);
     out.push(variant("collision-damped", &s, "collision", "model.general_damping", &["model.general_damping"]));

@@ -64,19 +64,19 @@ fn contact() -> impl Strategy<Value = [f64; 9]> {
         .prop_map(|(dn, a, vx, vy, w, hx, hy, b, rs)| [10f64.powf(dn) * 5e-4, a, vx, vy, 1e3 * w, hx, hy, b, rs])
 }
 
-fn lanes_match_alone<T: grainlab::physics::contact::tangential::Tangential>(
+fn lanes_match_alone<N: grainlab::physics::contact::normal::Normal, D: grainlab::physics::contact::damping::Damping, T: grainlab::physics::contact::tangential::Tangential>(
+    normal: N,
     cs: &[[f64; 9]; 4],
     limit_force: bool,
     lever_arm: grainlab::physics::contact::LeverArm,
     hist: impl Fn(&[f64; 9]) -> T::History<f64>,
     bits: impl Fn(&T::History<f64>) -> Vec<u64>,
 ) -> Result<(), TestCaseError> {
-    use grainlab::physics::contact::damping::Viscoelastic;
     use grainlab::physics::contact::{ContactInput, ContactModel, ModelOptions};
     use grainlab::physics::lanes::{Lanes, gather, gather2, lane2};
     use grainlab::physics::material::{Material, PairMaterial};
     use simba::simd::SimdValue;
-    let model = ContactModel::<Viscoelastic, T>::new(ModelOptions { limit_force, lever_arm });
+    let model = ContactModel::<N, D, T>::new(ModelOptions { limit_force, lever_arm }, normal);
     let pm = PairMaterial::mix(&Material::default(), &Material::default());
     let input = |c: &[f64; 9]| ContactInput {
         n: Vec2::new(c[1].cos(), c[1].sin()),
@@ -145,16 +145,19 @@ proptest! {
     fn four_lanes_give_each_contact_its_own_bits(c0 in contact(), c1 in contact(), c2 in contact(), c3 in contact(), clamp in any::<bool>(), lever in 0usize..3) {
         use grainlab::physics::contact::LeverArm;
         use grainlab::physics::contact::tangential::{IncrementalForce, IncrementalState, TotalDisplacement};
+        use grainlab::physics::contact::damping::{LinearRestitution, Viscoelastic};
+        use grainlab::physics::contact::normal::{Hertz, Hooke};
         let lever = [LeverArm::Radius, LeverArm::RadiusMinusHalfOverlap, LeverArm::Yade][lever];
         let cs = [c0, c1, c2, c3];
         let v = |v: &Vec2| vec![v.x.to_bits(), v.y.to_bits()];
-        lanes_match_alone::<TotalDisplacement>(&cs, clamp, lever, |c| Vec2::new(c[5], c[6]), v)?;
-        lanes_match_alone::<IncrementalForce>(
-            &cs,
-            clamp,
-            lever,
-            |c| IncrementalState { force: Vec2::new(c[5], c[6]) * 1e3, n_prev: Vec2::new(c[7].cos(), c[7].sin()) },
-            |h| [v(&h.force), v(&h.n_prev)].concat(),
-        )?;
+        let incremental = |c: &[f64; 9]| IncrementalState { force: Vec2::new(c[5], c[6]) * 1e3, n_prev: Vec2::new(c[7].cos(), c[7].sin()) };
+        let incremental_bits = |h: &IncrementalState| [v(&h.force), v(&h.n_prev)].concat();
+        lanes_match_alone::<Hertz, Viscoelastic, TotalDisplacement>(Hertz, &cs, clamp, lever, |c| Vec2::new(c[5], c[6]), v)?;
+        lanes_match_alone::<Hertz, Viscoelastic, IncrementalForce>(Hertz, &cs, clamp, lever, incremental, incremental_bits)?;
+        // The linear spring, derived per pair (a fifth root lane by lane) and given.
+        for spring in [Hooke::Derived { vc: 0.8 }, Hooke::Given { kn: 3e5, kt: 2e5 }] {
+            lanes_match_alone::<Hooke, LinearRestitution, TotalDisplacement>(spring, &cs, clamp, lever, |c| Vec2::new(c[5], c[6]), v)?;
+            lanes_match_alone::<Hooke, LinearRestitution, IncrementalForce>(spring, &cs, clamp, lever, incremental, incremental_bits)?;
+        }
     }
 }

@@ -13,6 +13,7 @@ use crate::error::{Error, Shown};
 use crate::kernels::pairs::PairList;
 use crate::physics::boundary::Boundary;
 use crate::physics::contact::damping::Damping;
+use crate::physics::contact::normal::{Hertz, Normal};
 use crate::physics::contact::model::*;
 use crate::physics::contact::tangential::Tangential;
 use crate::physics::contact::{ContactHistory, ContactModel, ModelOptions};
@@ -311,7 +312,7 @@ pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<B
     if let TimeStepRule::Accuracy { .. } = ts.rule {
         return Err(Error::Scene("an accuracy time step rule must be resolved first: build the scene with grainlab::build (the study's build), which calibrates it".into()));
     }
-    let time_step = choose(&ts.rule, ts.characteristic_speed, ts.allow_unstable, &refs, (r, m, mat), friction)?;
+    let time_step = choose(&scene.model.normal, &ts.rule, ts.characteristic_speed, ts.allow_unstable, &refs, (r, m, mat), friction)?;
     let dt = time_step.dt_s;
     let steps = crate::engine::timestep::step_count(scene.duration, dt, "duration")?;
     // Every stage of a protocol takes at least a step.
@@ -360,13 +361,19 @@ pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<B
     let tangential = if effects.friction { scene.model.tangential } else { TangentialSpec::Frictionless };
     let threads = crate::kernels::threads::Threads::new(threads)?;
     let parts = Parts { p, boundary, walls, dt, skin, scene, threads, domain, context };
-    let engine: Box<dyn Engine> = match (tangential, all_elastic) {
-        (TangentialSpec::Frictionless, false) => parts.assemble(HertzFrictionless::new(options))?,
-        (TangentialSpec::Frictionless, true) => parts.assemble(HertzFrictionlessElastic::new(options))?,
-        (TangentialSpec::TotalDisplacement, false) => parts.assemble(LiggghtsHertzHistory::new(options))?,
-        (TangentialSpec::TotalDisplacement, true) => parts.assemble(LiggghtsHertzHistoryElastic::new(options))?,
-        (TangentialSpec::IncrementalForce, false) => parts.assemble(YadeMindlin::new(options))?,
-        (TangentialSpec::IncrementalForce, true) => parts.assemble(YadeMindlinElastic::new(options))?,
+    let engine: Box<dyn Engine> = match (scene.model.normal.hooke(), tangential, all_elastic) {
+        (None, TangentialSpec::Frictionless, false) => parts.assemble(HertzFrictionless::new(options, Hertz))?,
+        (None, TangentialSpec::Frictionless, true) => parts.assemble(HertzFrictionlessElastic::new(options, Hertz))?,
+        (None, TangentialSpec::TotalDisplacement, false) => parts.assemble(LiggghtsHertzHistory::new(options, Hertz))?,
+        (None, TangentialSpec::TotalDisplacement, true) => parts.assemble(LiggghtsHertzHistoryElastic::new(options, Hertz))?,
+        (None, TangentialSpec::IncrementalForce, false) => parts.assemble(YadeMindlin::new(options, Hertz))?,
+        (None, TangentialSpec::IncrementalForce, true) => parts.assemble(YadeMindlinElastic::new(options, Hertz))?,
+        (Some(h), TangentialSpec::Frictionless, false) => parts.assemble(HookeFrictionless::new(options, h))?,
+        (Some(h), TangentialSpec::Frictionless, true) => parts.assemble(HookeFrictionlessElastic::new(options, h))?,
+        (Some(h), TangentialSpec::TotalDisplacement, false) => parts.assemble(LiggghtsHookeHistory::new(options, h))?,
+        (Some(h), TangentialSpec::TotalDisplacement, true) => parts.assemble(LiggghtsHookeHistoryElastic::new(options, h))?,
+        (Some(h), TangentialSpec::IncrementalForce, false) => parts.assemble(HookeIncremental::new(options, h))?,
+        (Some(h), TangentialSpec::IncrementalForce, true) => parts.assemble(HookeIncrementalElastic::new(options, h))?,
     };
     Ok(Built { engine, time_step, depth, length, effects, stages: scene.describe_stages() })
 }
@@ -415,12 +422,12 @@ struct Parts<'a> {
 }
 
 impl Parts<'_> {
-    fn assemble<Dm: Damping, T: Tangential>(self, law: ContactModel<Dm, T>) -> Result<Box<dyn Engine>, Error> {
-        if self.scene.output.energy { self.assemble_with::<Dm, T, true>(law) } else { self.assemble_with::<Dm, T, false>(law) }
+    fn assemble<N: Normal, Dm: Damping, T: Tangential>(self, law: ContactModel<N, Dm, T>) -> Result<Box<dyn Engine>, Error> {
+        if self.scene.output.energy { self.assemble_with::<N, Dm, T, true>(law) } else { self.assemble_with::<N, Dm, T, false>(law) }
     }
 
-    fn assemble_with<Dm: Damping, T: Tangential, const E: bool>(self, law: ContactModel<Dm, T>) -> Result<Box<dyn Engine>, Error> {
-        type L<Dm, T> = ContactModel<Dm, T>;
+    fn assemble_with<N: Normal, Dm: Damping, T: Tangential, const E: bool>(self, law: ContactModel<N, Dm, T>) -> Result<Box<dyn Engine>, Error> {
+        type L<N, Dm, T> = ContactModel<N, Dm, T>;
         let scene = self.scene;
         let rotation = T::FRICTION && scene.model.rotation;
         let has_walls = !self.walls.is_empty();
@@ -457,8 +464,8 @@ impl Parts<'_> {
         };
         // The force stages, shared by the step and by the set-up at t = 0.
         let threads = self.threads.clone();
-        let forces = || -> Result<Vec<Box<dyn Stage<L<Dm, T>>>>, Error> {
-            let mut s: Vec<Box<dyn Stage<L<Dm, T>>>> = vec![Box::new(UpdateNeighbours), Box::new(ClearForces)];
+        let forces = || -> Result<Vec<Box<dyn Stage<L<N, Dm, T>>>>, Error> {
+            let mut s: Vec<Box<dyn Stage<L<N, Dm, T>>>> = vec![Box::new(UpdateNeighbours), Box::new(ClearForces)];
             if pulled {
                 s.push(Box::new(Gravity::<E>));
             }
@@ -468,13 +475,13 @@ impl Parts<'_> {
             if scene.output.contacts {
                 s.push(if rotation { Box::new(RecordContacts::<true>) } else { Box::new(RecordContacts::<false>) });
             }
-            s.push(if rotation { pair_stage::<Dm, T, E, true>(&threads) } else { pair_stage::<Dm, T, E, false>(&threads) });
+            s.push(if rotation { pair_stage::<N, Dm, T, E, true>(&threads) } else { pair_stage::<N, Dm, T, E, false>(&threads) });
             if has_flat {
                 s.push(Box::new(FlatWallForces::<E>));
             }
             Ok(s)
         };
-        let mut stages: Vec<Box<dyn Stage<L<Dm, T>>>> = Vec::new();
+        let mut stages: Vec<Box<dyn Stage<L<N, Dm, T>>>> = Vec::new();
         // The walls first: their grains follow them in the drift.
         if has_walls {
             stages.push(Box::new(MoveWalls));
@@ -504,7 +511,7 @@ impl Parts<'_> {
 
 /// The grain-grain contact stage: serial, or on the run's pool of threads; with `SPIN` when
 /// the grains rotate (without, the kernel neither reads spins nor computes torques).
-fn pair_stage<Dm: Damping, T: Tangential, const E: bool, const SPIN: bool>(threads: &crate::kernels::threads::Threads) -> Box<dyn Stage<ContactModel<Dm, T>>> {
+fn pair_stage<N: Normal, Dm: Damping, T: Tangential, const E: bool, const SPIN: bool>(threads: &crate::kernels::threads::Threads) -> Box<dyn Stage<ContactModel<N, Dm, T>>> {
     #[cfg(feature = "parallel")]
     if threads.count() > 1 {
         return Box::new(crate::engine::parallel::ParallelPairForces::<E, SPIN>::new(threads.clone()));

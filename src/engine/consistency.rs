@@ -306,7 +306,7 @@ pub fn stable_for_every_pair(scene: &Scene, p: &Particles, walls: &[Wall], info:
         }
     }
     let v = info.characteristic_speed_m_s;
-    let limit = |c: &RefContact| crate::engine::timestep::stability_limit(std::slice::from_ref(c), v, friction);
+    let limit = |c: &RefContact| crate::engine::timestep::stability_limit(&scene.model.normal, std::slice::from_ref(c), v, friction);
     let Some(k) = (0..refs.len()).min_by(|&x, &y| limit(&refs[x]).total_cmp(&limit(&refs[y]))) else { return Ok(()) };
     let worst = limit(&refs[k]);
     if !(info.dt_s <= worst) {
@@ -379,28 +379,39 @@ fn load_on(scene: &Scene, p: &Particles, walls: &[Wall], wall: &Wall, pressure: 
     used.sort_unstable();
     used.dedup();
     let mats = &scene.materials;
-    let e_star = used.iter().flat_map(|&a| used.iter().map(move |&b| PairMaterial::mix(&mats[a], &mats[b]).e_star)).fold(f64::INFINITY, f64::min);
+    let soft = used.iter().flat_map(|&a| used.iter().map(move |&b| PairMaterial::mix(&mats[a], &mats[b]))).min_by(|x, y| x.e_star.total_cmp(&y.e_star));
+    let Some(soft) = soft else { return Ok(()) };
+    let e_star = soft.e_star;
     // One contact per grain diameter along the wall, each carrying the load on a
-    // diameter of the wall's area: F = p (2 r) t; Hertz between two mean grains
-    // (R* = r/2): F = 4/3 E* sqrt(R*) dn^1.5.
+    // diameter of the wall's area: F = p (2 r) t, between two mean grains (R* = r/2,
+    // m* = m/2). Hertz: F = 4/3 E* sqrt(R*) dn^1.5; the linear spring: F = kn dn.
     let r_star = 0.5 * r_mean;
+    let m_star = 0.5 * p.m[..n_free].iter().sum::<f64>() / n_free as f64;
     let force = pressure * 2.0 * r_mean * depth;
-    let dn = (0.75 * force / (e_star * r_star.sqrt())).powf(2.0 / 3.0);
+    let law = scene.model.normal;
+    let spring = law.hooke().map(|_| law.stiffness(&soft, r_star, m_star, 0.0).kn);
+    let dn = match spring {
+        None => (0.75 * force / (e_star * r_star.sqrt())).powf(2.0 / 3.0),
+        Some(kn) => force / kn,
+    };
     let most = MAX_LOAD_OVERLAP * r_mean;
     if !(dn <= most) {
-        let p_max = 4.0 / 3.0 * e_star * r_star.sqrt() * most.powf(1.5) / (2.0 * r_mean * depth);
+        let (p_max, what) = match spring {
+            None => (4.0 / 3.0 * e_star * r_star.sqrt() * most.powf(1.5) / (2.0 * r_mean * depth), format!("E* = {e_star:.3e} Pa")),
+            Some(kn) => (kn * most / (2.0 * r_mean * depth), format!("kn = {kn:.3e} N/m")),
+        };
         return Err(refuse(
             format!("{at}.control.pressure"),
             format!("{pressure} Pa"),
             format!(
-                "at most {p_max:.3e} Pa for these grains (E* = {e_star:.3e} Pa): the load would press each contact in by about {:.3} of a radius (the contact law is meant for under {MAX_LOAD_OVERLAP}; the watchdog stops at {MAX_START_OVERLAP})",
+                "at most {p_max:.3e} Pa for these grains ({what}): the load would press each contact in by about {:.3} of a radius (the contact law is meant for under {MAX_LOAD_OVERLAP}; the watchdog stops at {MAX_START_OVERLAP})",
                 dn / r_mean
             ),
         ));
     }
-    // The wall on its contacts: stiffness dF/ddn = 2 E* sqrt(R* dn) each, one per grain
-    // diameter; stable while dt <= 2 / omega, omega^2 = n k / M.
-    let k = 2.0 * e_star * (r_star * dn).sqrt();
+    // The wall on its contacts: stiffness dF/ddn (Hertz 2 E* sqrt(R* dn), the spring kn)
+    // each, one per grain diameter; stable while dt <= 2 / omega, omega^2 = n k / M.
+    let k = spring.unwrap_or_else(|| 2.0 * e_star * (r_star * dn).sqrt());
     let contacts = (length / (2.0 * r_mean)).max(1.0);
     let omega = (contacts * k / wall.mass).sqrt();
     if !(dt * omega <= 2.0) {

@@ -77,7 +77,14 @@ impl Effects {
         let mut list = Vec::new();
         let mut push = |name: &str, on: bool, why: String, measured_as: Option<&'static str>| list.push(Effect { name: name.into(), on, why, measured_as });
 
-        push("Hertz normal force", true, "always".into(), None);
+        let (normal, normal_why) = match scene.model.normal {
+            crate::scene::NormalLaw::Hertz => ("Hertz normal force", "always (model.normal = hertz, the default)".to_string()),
+            crate::scene::NormalLaw::Hooke { characteristic_velocity } => {
+                ("linear spring normal force", format!("declared: model.normal = hooke, kn = kt derived per pair at vc = {characteristic_velocity} m/s"))
+            }
+            crate::scene::NormalLaw::HookeStiffness { kn, kt } => ("linear spring normal force", format!("declared: model.normal = hooke_stiffness, kn = {kn} N/m, kt = {kt} N/m")),
+        };
+        push(normal, true, normal_why, if scene.model.normal.is_hertz() { None } else { Some("linear spring (hooke)") });
         // Friction: declared off, or derived off from the coefficients of the pairs that
         // can touch.
         let rubbing = pairs.iter().find(|q| mix(q).friction > 0.0);

@@ -47,6 +47,7 @@ use crate::kernels::sweep::sort_pairs;
 use crate::kernels::threads::Threads;
 use crate::physics::contact::ContactModel;
 use crate::physics::contact::damping::Damping;
+use crate::physics::contact::normal::Normal;
 use crate::physics::contact::tangential::Tangential;
 use crate::physics::dim::Vec2;
 use std::sync::OnceLock;
@@ -370,7 +371,7 @@ impl<const ENERGY: bool, const SPIN: bool> ParallelPairForces<ENERGY, SPIN> {
     }
 }
 
-impl<Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN: bool> Stage<ContactModel<Dm, T>> for ParallelPairForces<ENERGY, SPIN> {
+impl<N: Normal, Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN: bool> Stage<ContactModel<N, Dm, T>> for ParallelPairForces<ENERGY, SPIN> {
     fn name(&self) -> String {
         format!("PairContacts(parallel, {} threads)", self.scratch.len())
     }
@@ -380,7 +381,7 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN: bool> Stage<Con
         self.built_for = u64::MAX;
         if carried.is_empty() { Ok(()) } else { Err(format!("the parallel contact stage carries nothing, the checkpoint gave it {} numbers", carried.len())) }
     }
-    fn run(&mut self, w: &mut World<ContactModel<Dm, T>>) -> Result<(), Error> {
+    fn run(&mut self, w: &mut World<ContactModel<N, Dm, T>>) -> Result<(), Error> {
         let (n, n_free) = (w.p.len(), w.p.n_free);
         let np = w.pairs.pairs.len();
         self.since_cut += 1;
@@ -440,7 +441,7 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN: bool> Stage<Con
                         }
                         cross_out[slot] = o;
                     };
-                    compute_pairs::<Dm, T, ENERGY, SPIN>(&view, list, &touching[..nt], &sep[..nt], &released[..nr], sink);
+                    compute_pairs::<N, Dm, T, ENERGY, SPIN>(&view, list, &touching[..nt], &sep[..nt], &released[..nr], sink);
                 }
                 let own_cross: &[PairOut] = cross_out;
                 let _ = published[r].set(own_cross);
@@ -489,7 +490,7 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN: bool> Stage<Con
                     }
                 };
                 let sink = |_, ij: (usize, usize), o: PairOut| add(ij, &o, true);
-                let (ratio, kk) = compute_pairs::<Dm, T, ENERGY, SPIN>(&view, list, &touching[..nt], &sep[..nt], &released[..nr], sink);
+                let (ratio, kk) = compute_pairs::<N, Dm, T, ENERGY, SPIN>(&view, list, &touching[..nt], &sep[..nt], &released[..nr], sink);
                 let mut best = if kk == usize::MAX { (0.0, usize::MAX) } else { (ratio, part.start + kk) };
                 // (5) Our cross pairs' forces on our grains: a grain's pairs (g, j) with j in
                 // a later range are the last of its sequence.

@@ -10,6 +10,7 @@ use crate::error::Error;
 use crate::kernels::driver::{PairOut, PairSlices, PairView, compute_pairs, record_pair};
 use crate::kernels::sweep::sort_pairs;
 use crate::physics::contact::damping::Damping;
+use crate::physics::contact::normal::Normal;
 use crate::physics::contact::tangential::Tangential;
 use crate::physics::contact::{ContactInput, ContactLaw, ContactModel, ContactRecord, Partner};
 use crate::physics::dim::{Vec2, cross};
@@ -178,11 +179,11 @@ pub struct PairForces<const ENERGY: bool, const SPIN: bool> {
     released: Vec<u32>,
 }
 
-impl<Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN: bool> Stage<ContactModel<Dm, T>> for PairForces<ENERGY, SPIN> {
+impl<N: Normal, Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN: bool> Stage<ContactModel<N, Dm, T>> for PairForces<ENERGY, SPIN> {
     fn name(&self) -> String {
         "PairContacts".into()
     }
-    fn run(&mut self, w: &mut World<ContactModel<Dm, T>>) -> Result<(), Error> {
+    fn run(&mut self, w: &mut World<ContactModel<N, Dm, T>>) -> Result<(), Error> {
         let mut worst = w.max_overlap;
         let mut f = std::mem::take(&mut w.p.f);
         let mut torque = std::mem::take(&mut w.p.torque);
@@ -202,7 +203,7 @@ impl<Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN: bool> Stage<Con
                 ts[j] -= o.torque[1];
             }
         };
-        let (ratio, k) = compute_pairs::<Dm, T, ENERGY, SPIN>(&view, list, touching, sep, released, sink);
+        let (ratio, k) = compute_pairs::<N, Dm, T, ENERGY, SPIN>(&view, list, touching, sep, released, sink);
         if ratio > worst.0 {
             let [i, j] = pairs.pairs()[k];
             worst = (ratio, i as usize, j as usize);
@@ -230,11 +231,11 @@ fn wall_input<T: Tangential>(lever: crate::physics::contact::LeverArm, p: &crate
 /// `output.contacts` asks, and at the other steps a flag test.
 pub struct RecordContacts<const SPIN: bool>;
 
-impl<Dm: Damping, T: Tangential, const SPIN: bool> Stage<ContactModel<Dm, T>> for RecordContacts<SPIN> {
+impl<N: Normal, Dm: Damping, T: Tangential, const SPIN: bool> Stage<ContactModel<N, Dm, T>> for RecordContacts<SPIN> {
     fn name(&self) -> String {
         "RecordContacts".into()
     }
-    fn run(&mut self, w: &mut World<ContactModel<Dm, T>>) -> Result<(), Error> {
+    fn run(&mut self, w: &mut World<ContactModel<N, Dm, T>>) -> Result<(), Error> {
         if !w.probe.wanted {
             return Ok(());
         }
@@ -247,7 +248,7 @@ impl<Dm: Damping, T: Tangential, const SPIN: bool> Stage<ContactModel<Dm, T>> fo
         pr.walls = w.walls.iter().map(|wall| (wall.contact_surface(), wall.v)).collect();
         let view = PairView { p: &w.p, boundary: w.boundary, law: w.law, pair_table: &w.pair_table, dt: w.dt };
         for (k, &[i, j]) in w.pairs.pairs.checked().pairs().iter().enumerate() {
-            if let Some(c) = record_pair::<Dm, T, SPIN>(&view, (i as usize, j as usize), &w.pairs.consts[k], &w.pairs.hist[k]) {
+            if let Some(c) = record_pair::<N, Dm, T, SPIN>(&view, (i as usize, j as usize), &w.pairs.consts[k], &w.pairs.hist[k]) {
                 out.push(c);
             }
         }
@@ -292,11 +293,11 @@ impl<Dm: Damping, T: Tangential, const SPIN: bool> Stage<ContactModel<Dm, T>> fo
 /// Contacts of free grains with flat walls (R* = r, m* = m).
 pub struct FlatWallForces<const ENERGY: bool>;
 
-impl<Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<Dm, T>> for FlatWallForces<ENERGY> {
+impl<N: Normal, Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<N, Dm, T>> for FlatWallForces<ENERGY> {
     fn name(&self) -> String {
         "FlatWallContacts".into()
     }
-    fn run(&mut self, w: &mut World<ContactModel<Dm, T>>) -> Result<(), Error> {
+    fn run(&mut self, w: &mut World<ContactModel<N, Dm, T>>) -> Result<(), Error> {
         let model = w.law;
         let lever = model.options.lever_arm;
         let dt = w.dt;

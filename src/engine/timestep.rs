@@ -2,7 +2,8 @@
 //!
 //! The reference contact for every estimate is the most demanding one a scene has: the
 //! smallest grain against another like it, and against a flat wall when there is one.
-//! - Hertz contact time at speed v: `t_c = 2.868 (m*^2 / (R* E*^2 v))^(1/5)`.
+//! - Contact time at speed v: Hertz `t_c = 2.868 (m*^2 / (R* E*^2 v))^(1/5)`, the linear
+//!   spring `pi sqrt(m*/kn)` (elastic, whatever v).
 //! - Stability of velocity Verlet: `dt < 2 / omega_max`, with `omega_n^2 = Sn / m*` and,
 //!   with friction, `omega_t^2 = kt (1/m_i + 1/m_j + a_i^2/I_i + a_j^2/I_j)`, both
 //!   stiffnesses taken at the maximum overlap of an impact at the characteristic speed.
@@ -11,8 +12,8 @@
 use serde::Serialize;
 
 use crate::error::{Error, check};
-use crate::physics::contact::normal::HertzStiffness;
-use crate::physics::material::{Material, PairMaterial, hertz_contact_time, hertz_max_overlap, rayleigh_time};
+use crate::physics::contact::normal::NormalLaw;
+use crate::physics::material::{Material, PairMaterial, rayleigh_time};
 use crate::scene::TimeStepRule;
 
 /// A reference contact: reduced radius and mass, the pair's moduli, and the inverse
@@ -54,7 +55,7 @@ impl RefContact {
 pub struct TimeStepInfo {
     /// Time step, s.
     pub dt_s: f64,
-    /// Hertz contact time of the reference contact at the characteristic speed, s.
+    /// Elastic contact time of the reference contact at the characteristic speed, s.
     pub contact_time_s: f64,
     /// Steps per contact, t_c / dt.
     pub steps_per_contact: f64,
@@ -68,14 +69,15 @@ pub struct TimeStepInfo {
     pub accuracy: Option<AccuracyNote>,
 }
 
-/// Contact time, stability limit over the reference contacts at speed `v`.
-fn limits(refs: &[RefContact], v: f64, friction: bool) -> (f64, f64) {
+/// Contact time, stability limit over the reference contacts at speed `v` under the
+/// normal law `law`.
+fn limits(law: &NormalLaw, refs: &[RefContact], v: f64, friction: bool) -> (f64, f64) {
     let mut tc = f64::INFINITY;
     let mut omega: f64 = 0.0;
     for c in refs {
-        tc = tc.min(hertz_contact_time(c.m_star, c.r_star, c.pair.e_star, v));
-        let dmax = hertz_max_overlap(c.m_star, c.r_star, c.pair.e_star, v);
-        let s = HertzStiffness::new(c.pair.e_star, c.pair.g_star, c.r_star, dmax);
+        tc = tc.min(law.contact_time(&c.pair, c.r_star, c.m_star, v));
+        let dmax = law.max_overlap(&c.pair, c.r_star, c.m_star, v);
+        let s = law.stiffness(&c.pair, c.r_star, c.m_star, dmax);
         omega = omega.max((s.sn / c.m_star).sqrt());
         if friction {
             omega = omega.max((s.kt * c.inv_tangential_mass).sqrt());
@@ -84,13 +86,17 @@ fn limits(refs: &[RefContact], v: f64, friction: bool) -> (f64, f64) {
     (tc, 2.0 / omega)
 }
 
-/// The stability limit 2 / omega_max over the contacts `refs` at speed `v`, s.
-pub fn stability_limit(refs: &[RefContact], v: f64, friction: bool) -> f64 {
-    limits(refs, v, friction).1
+/// The stability limit 2 / omega_max over the contacts `refs` at speed `v` under the
+/// normal law `law`, s.
+pub fn stability_limit(law: &NormalLaw, refs: &[RefContact], v: f64, friction: bool) -> f64 {
+    limits(law, refs, v, friction).1
 }
 
-/// Apply the rule. `smallest` is the smallest grain's (radius, mass, material).
+/// Apply the rule under the normal law `law`. `smallest` is the smallest grain's
+/// (radius, mass, material).
+#[allow(clippy::too_many_arguments)]
 pub fn choose(
+    law: &NormalLaw,
     rule: &TimeStepRule,
     characteristic_speed: Option<f64>,
     allow_unstable: bool,
@@ -102,7 +108,7 @@ pub fn choose(
         TimeStepRule::StepsPerContact { impact_speed, .. } | TimeStepRule::Accuracy { impact_speed, .. } => *impact_speed,
         _ => 1.0,
     });
-    let (tc, limit) = limits(refs, v, friction);
+    let (tc, limit) = limits(law, refs, v, friction);
     let rayleigh = rayleigh_time(smallest.0, smallest.2);
     // Moduli, densities or speeds at the edge of the floating-point range give a contact
     // time or limit of 0 or infinity, from which no time step follows.
@@ -116,12 +122,12 @@ pub fn choose(
     }
     let dt = match *rule {
         TimeStepRule::Fixed { dt } => dt,
-        TimeStepRule::StepsPerContact { steps, impact_speed } => limits(refs, impact_speed, friction).0 / steps,
+        TimeStepRule::StepsPerContact { steps, impact_speed } => limits(law, refs, impact_speed, friction).0 / steps,
         TimeStepRule::Accuracy { .. } => unreachable!("build() calibrates an accuracy rule into steps per contact first"),
         TimeStepRule::RayleighFraction { fraction } => fraction * rayleigh,
         TimeStepRule::SeedRule { factor, reference_overlap } => {
             let dn = reference_overlap * smallest.0;
-            let k_max = refs.iter().map(|c| HertzStiffness::new(c.pair.e_star, c.pair.g_star, c.r_star, dn).kn).fold(0.0, f64::max);
+            let k_max = refs.iter().map(|c| law.stiffness(&c.pair, c.r_star, c.m_star, dn).kn).fold(0.0, f64::max);
             factor * 2.0 * (smallest.1 / k_max).sqrt()
         }
     };

@@ -110,7 +110,7 @@ impl<L: ContactLaw> World<L> {
             let dn = p.r[i] + p.r[j] - self.boundary.image(p.x[i] - p.x[j]).norm();
             if dn > 0.0 {
                 let pm = self.pair_table.get(p.material[i] as usize, p.material[j] as usize);
-                let (un, ut) = self.law.stored_energy(pm, list.consts[k].r_star, dn, e.fte_prev);
+                let (un, ut) = self.law.stored_energy(pm, list.consts[k].r_star, list.consts[k].sqrt_m_star, dn, e.fte_prev);
                 l.elastic_normal += un;
                 l.elastic_tangential += ut;
             }

@@ -10,6 +10,7 @@ use simba::simd::{SimdBool, SimdPartialOrd, SimdValue};
 use crate::kernels::pairs::{CheckedPairs, PairConst};
 use crate::physics::boundary::Boundary;
 use crate::physics::contact::damping::Damping;
+use crate::physics::contact::normal::Normal;
 use crate::physics::contact::tangential::Tangential;
 use crate::physics::contact::model::ContactState;
 use crate::physics::contact::{ContactInput, ContactLaw, ContactModel, ContactRecord, EnergyMemory, LeverArm, Partner};
@@ -55,8 +56,8 @@ fn pair_torque<R: Real>(lever: LeverArm, c: &ContactInput<R>, ft: Vector2<R>, ri
 /// (released), or nothing; tangential state `h` and (with `ENERGY`) energy memory `e`
 /// updated.
 #[inline(always)]
-pub fn pair_contact<Dm: Damping, T: Tangential, const ENERGY: bool>(
-    w: &PairView<'_, ContactModel<Dm, T>>,
+pub fn pair_contact<N: Normal, Dm: Damping, T: Tangential, const ENERGY: bool>(
+    w: &PairView<'_, ContactModel<N, Dm, T>>,
     pair: [u32; 2],
     pc: &PairConst,
     h: &mut T::History<f64>,
@@ -80,7 +81,7 @@ pub fn pair_contact<Dm: Damping, T: Tangential, const ENERGY: bool>(
         }
         return PairOut::default();
     }
-    let (o, n, state) = one_pair::<Dm, T, true>(w, (i, j), d, pc, h, active);
+    let (o, n, state) = one_pair::<N, Dm, T, true>(w, (i, j), d, pc, h, active);
     if ENERGY {
         model.energy_step(n, w.dt, &state, e);
     }
@@ -94,8 +95,8 @@ pub fn pair_contact<Dm: Damping, T: Tangential, const ENERGY: bool>(
 /// (grains that do not rotate) the spins are not read and the torques not computed.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-fn four_pairs<Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN: bool>(
-    w: &PairView<'_, ContactModel<Dm, T>>,
+fn four_pairs<N: Normal, Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN: bool>(
+    w: &PairView<'_, ContactModel<N, Dm, T>>,
     list: PairSlices<'_, T>,
     single: Option<&PairMaterial<Lanes>>,
     ks: &[u32],
@@ -172,8 +173,8 @@ fn four_pairs<Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN: bool>(
 /// its output, advancing its tangential state `h`, and what its energy accounting needs
 /// (the normal and the step's contact state).
 #[inline(always)]
-fn one_pair<Dm: Damping, T: Tangential, const SPIN: bool>(
-    w: &PairView<'_, ContactModel<Dm, T>>,
+fn one_pair<N: Normal, Dm: Damping, T: Tangential, const SPIN: bool>(
+    w: &PairView<'_, ContactModel<N, Dm, T>>,
     (i, j): (usize, usize),
     d: Vec2,
     pc: &PairConst,
@@ -194,7 +195,7 @@ fn one_pair<Dm: Damping, T: Tangential, const SPIN: bool>(
 /// (positions, velocities and tangential state `h` as they are now): its record, or
 /// `None` when it does not touch. The same function of the same inputs as the stage's
 /// (`one_pair`, whose lanes give the same bits), on a copy of the state: nothing moves.
-pub fn record_pair<Dm: Damping, T: Tangential, const SPIN: bool>(w: &PairView<'_, ContactModel<Dm, T>>, (i, j): (usize, usize), pc: &PairConst, h: &T::History<f64>) -> Option<ContactRecord> {
+pub fn record_pair<N: Normal, Dm: Damping, T: Tangential, const SPIN: bool>(w: &PairView<'_, ContactModel<N, Dm, T>>, (i, j): (usize, usize), pc: &PairConst, h: &T::History<f64>) -> Option<ContactRecord> {
     let p = w.p;
     let d = w.boundary.image(p.x[i] - p.x[j]);
     let (ri, rj) = (p.r[i], p.r[j]);
@@ -202,7 +203,7 @@ pub fn record_pair<Dm: Damping, T: Tangential, const SPIN: bool>(w: &PairView<'_
         return None;
     }
     let (mut h, mut active) = (*h, true);
-    let (_, n, c) = one_pair::<Dm, T, SPIN>(w, (i, j), d, pc, &mut h, &mut active);
+    let (_, n, c) = one_pair::<N, Dm, T, SPIN>(w, (i, j), d, pc, &mut h, &mut active);
     let dn = ri + rj - d.norm();
     Some(ContactRecord {
         i: i as u32,
@@ -236,8 +237,8 @@ pub struct PairSlices<'a, T: Tangential> {
 /// them for the ledger. Returns the largest overlap over the smaller radius of the
 /// touching pairs and the index (in the part) of the first pair that has it,
 /// `(0, usize::MAX)` if none touches.
-pub fn compute_pairs<Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN: bool>(
-    w: &PairView<'_, ContactModel<Dm, T>>,
+pub fn compute_pairs<N: Normal, Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN: bool>(
+    w: &PairView<'_, ContactModel<N, Dm, T>>,
     list: PairSlices<'_, T>,
     touching: &[u32],
     sep: &[Vec2],
@@ -251,12 +252,12 @@ pub fn compute_pairs<Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN:
     let PairSlices { pairs, consts, hist, energy, active } = list;
     for (ks, ds) in touching[..quads].chunks_exact(LANES).zip(sep.chunks_exact(LANES)) {
         let slices = PairSlices::<T> { pairs, consts, hist: &mut *hist, energy: &mut *energy, active: &mut *active };
-        four_pairs::<Dm, T, ENERGY, SPIN>(w, slices, single.as_ref(), ks, ds, &mut sink, &mut best);
+        four_pairs::<N, Dm, T, ENERGY, SPIN>(w, slices, single.as_ref(), ks, ds, &mut sink, &mut best);
     }
     for (m, &k) in touching.iter().enumerate().skip(quads) {
         let k = k as usize;
         let [i, j] = pairs.pairs()[k].map(|g| g as usize);
-        let (o, n, state) = one_pair::<Dm, T, SPIN>(w, (i, j), sep[m], &consts[k], &mut hist[k], &mut active[k]);
+        let (o, n, state) = one_pair::<N, Dm, T, SPIN>(w, (i, j), sep[m], &consts[k], &mut hist[k], &mut active[k]);
         if o.ratio > best.0 {
             best = (o.ratio, k);
         }
@@ -269,7 +270,7 @@ pub fn compute_pairs<Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN:
     for &k in released {
         let k = k as usize;
         let e = if ENERGY { &mut energy[k] } else { &mut none };
-        pair_contact::<Dm, T, ENERGY>(w, pairs.pairs()[k], &consts[k], &mut hist[k], e, &mut active[k]);
+        pair_contact::<N, Dm, T, ENERGY>(w, pairs.pairs()[k], &consts[k], &mut hist[k], e, &mut active[k]);
     }
     best
 }

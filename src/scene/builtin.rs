@@ -24,9 +24,16 @@ fn glass(restitution: f64) -> Material {
 /// through a step at every speed and time step: the realised restitution depends on
 /// that phase at O(dt/t_c), and fixing it makes results depend on dt/t_c alone.
 pub fn head_on(material: Material, r: f64, v: f64, steps_per_contact: f64) -> Scene {
+    head_on_under(NormalLaw::Hertz, material, r, v, steps_per_contact)
+}
+
+/// [`head_on`] under the normal law `law` (its contact time sets the time step and the
+/// approach).
+pub fn head_on_under(law: NormalLaw, material: Material, r: f64, v: f64, steps_per_contact: f64) -> Scene {
     let m = 4.0 / 3.0 * std::f64::consts::PI * r * r * r * material.density;
-    let e_star = crate::physics::material::PairMaterial::mix(&material, &material).e_star;
-    let dt = crate::physics::material::hertz_contact_time(m / 2.0, r / 2.0, e_star, v) / steps_per_contact;
+    let pm = crate::physics::material::PairMaterial::mix(&material, &material);
+    let tc = law.contact_time(&pm, r / 2.0, m / 2.0, v);
+    let dt = tc / steps_per_contact;
     let gap = 10.5 * v * dt;
     Scene {
         name: "collision".into(),
@@ -40,14 +47,14 @@ pub fn head_on(material: Material, r: f64, v: f64, steps_per_contact: f64) -> Sc
         ]),
         walls: None,
         gravity: [0.0, 0.0],
-        model: ModelSpec::default(),
+        model: ModelSpec { normal: law, ..ModelSpec::default() },
         time_step: TimeStepSpec {
             rule: TimeStepRule::StepsPerContact { steps: steps_per_contact, impact_speed: v },
             characteristic_speed: None,
             allow_unstable: false,
         },
         // The approach and three contact times (the run stops at separation anyway).
-        duration: 2.0 * gap / v + 3.0 * crate::physics::material::hertz_contact_time(m / 2.0, r / 2.0, e_star, v),
+        duration: 2.0 * gap / v + 3.0 * tc,
         neighbor: NeighborSpec::default(),
         output: OutputSpec { samples: 200, frames: 0, energy: true, contacts: false },
         analysis: Analysis::Impact,

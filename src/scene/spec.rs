@@ -9,6 +9,7 @@ use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 use crate::physics::contact::LeverArm;
+pub use crate::physics::contact::normal::NormalLaw;
 use crate::physics::dim::GrainShape;
 use crate::physics::material::Material;
 use crate::scene::pack::RadiusDist;
@@ -315,6 +316,11 @@ pub enum TangentialSpec {
 #[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ModelSpec {
+    /// Normal law: `"hertz"` (default), `{"hooke": {"characteristic_velocity": vc}}` or
+    /// `{"hooke_stiffness": {"kn": .., "kt": ..}}` (the linear spring; see
+    /// [`NormalLaw`]). Left out of written scenes when it is Hertz.
+    #[serde(default, skip_serializing_if = "NormalLaw::is_hertz")]
+    pub normal: NormalLaw,
     #[serde(default)]
     pub tangential: TangentialSpec,
     /// Clamp Fn >= 0 (LIGGGHTS `limitForce`). Default false.
@@ -339,7 +345,7 @@ fn yes() -> bool {
 
 impl Default for ModelSpec {
     fn default() -> Self {
-        ModelSpec { tangential: TangentialSpec::default(), limit_force: false, lever_arm: LeverArm::default(), rotation: true, general_damping: None }
+        ModelSpec { normal: NormalLaw::Hertz, tangential: TangentialSpec::default(), limit_force: false, lever_arm: LeverArm::default(), rotation: true, general_damping: None }
     }
 }
 

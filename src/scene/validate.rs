@@ -153,6 +153,16 @@ impl Scene {
                 check(finite_pos(impact_speed), "time_step.rule.accuracy", "impact_speed", impact_speed, "> 0 m/s")?;
             }
         }
+        match self.model.normal {
+            crate::scene::NormalLaw::Hertz => {}
+            crate::scene::NormalLaw::Hooke { characteristic_velocity: v } => {
+                check(finite_pos(v), "model.normal.hooke", "characteristic_velocity", v, "> 0 m/s")?;
+            }
+            crate::scene::NormalLaw::HookeStiffness { kn, kt } => {
+                check(finite_pos(kn), "model.normal.hooke_stiffness", "kn", kn, "> 0 N/m")?;
+                check(finite_pos(kt), "model.normal.hooke_stiffness", "kt", kt, "> 0 N/m")?;
+            }
+        }
         if let Some(c) = self.model.general_damping {
             check(finite_pos(c), "model", "general_damping", c, "> 0 1/s (omit it for none)")?;
         }

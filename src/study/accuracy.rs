@@ -15,7 +15,6 @@ use crate::engine::timestep::AccuracyNote;
 use crate::error::Error;
 use crate::observe::impact::{ImpactObserver, ImpactSummary};
 use crate::physics::material::Material;
-use crate::scene::builtin::head_on;
 use crate::scene::limits::Limits;
 use crate::scene::{AccuracyQuantity, Scene, TimeStepRule};
 
@@ -65,7 +64,7 @@ pub fn step_impact(built: &mut Built, scene: &Scene) -> Result<ImpactObserver, E
 pub struct Calibration {
     pub quantity: AccuracyQuantity,
     pub tolerance: f64,
-    /// The chosen steps per Hertz contact time.
+    /// The chosen steps per contact time (of the scene's normal law).
     pub steps_per_contact: f64,
     /// The measured error there.
     pub measured_error: f64,
@@ -81,10 +80,16 @@ pub fn ladder() -> Vec<f64> {
 }
 
 /// Calibrate: the fewest steps per contact meeting `tolerance` for a head-on impact of
-/// two grains of radius `r` and `material` at `speed`, with the clamp as given.
+/// two grains of radius `r` and `material` at `speed`, with the clamp as given, under
+/// the Hertz law.
 pub fn calibrate(material: &Material, r: f64, speed: f64, limit_force: bool, quantity: AccuracyQuantity, tolerance: f64) -> Result<Calibration, Error> {
+    calibrate_under(crate::scene::NormalLaw::Hertz, material, r, speed, limit_force, quantity, tolerance)
+}
+
+/// [`calibrate`] under the normal law `law` (steps per its contact time).
+pub fn calibrate_under(law: crate::scene::NormalLaw, material: &Material, r: f64, speed: f64, limit_force: bool, quantity: AccuracyQuantity, tolerance: f64) -> Result<Calibration, Error> {
     let run = |n: f64| -> Result<ImpactSummary, Error> {
-        let mut s = head_on(material.clone(), r, speed, n);
+        let mut s = crate::scene::builtin::head_on_under(law, material.clone(), r, speed, n);
         s.model.limit_force = limit_force;
         s.model.tangential = crate::scene::TangentialSpec::Frictionless;
         s.output.energy = false;
@@ -140,7 +145,7 @@ pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<B
     };
     scene.validate()?;
     let (r, material) = scene.smallest_grain(limits)?;
-    let cal = calibrate(&scene.materials[material], r, impact_speed, scene.model.limit_force, quantity, tolerance)?;
+    let cal = calibrate_under(scene.model.normal, &scene.materials[material], r, impact_speed, scene.model.limit_force, quantity, tolerance)?;
     let mut resolved = scene.clone();
     resolved.time_step.rule = TimeStepRule::StepsPerContact { steps: cal.steps_per_contact, impact_speed };
     let mut built = crate::engine::build::build_limited(&resolved, threads, limits)?;

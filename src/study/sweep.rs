@@ -422,6 +422,13 @@ pub fn sweep(scene: &Scene, plan: &SweepPlan, limits: &Limits, mut progress: imp
     }
     crate::error::check_option((1..=MAX_REPEATS).contains(&plan.repeats), "--repeats", plan.repeats as f64, &format!("1 to {MAX_REPEATS}"))?;
     let lever = if stiffness.len() >= 2 { Lever::Stiffness } else { Lever::TimeStep };
+    if let (Lever::Stiffness, crate::scene::NormalLaw::HookeStiffness { kn, .. }) = (lever, scene.model.normal) {
+        return Err(Error::BadOption {
+            option: "--stiffness".into(),
+            value: format!("{} scales", stiffness.len()),
+            allowed: format!("a scene whose stiffness follows Young's modulus (hertz, hooke): model.normal.hooke_stiffness gives kn = {kn} N/m, which the sweep's scaling of E would leave as it is"),
+        });
+    }
     let steps = match lever {
         Lever::TimeStep if plan.steps.is_empty() => {
             return Err(Error::BadOption { option: "--steps/--rayleigh".into(), value: "none".into(), allowed: "at least one time step, or two or more --stiffness scales".into() });
@@ -692,7 +699,8 @@ struct Closed {
 /// Closed-form values for a two-grain head-on impact of equal sphere-in-plane grains.
 fn closed_form(s: &Scene) -> Option<Closed> {
     let Grains::List(g) = &s.grains else { return None };
-    if g.len() != 2 || g[0].r != g[1].r || g[0].material != g[1].material || s.walls.is_some() {
+    // Hertz's closed forms (the linear spring's are in tests/hooke.rs).
+    if !s.model.normal.is_hertz() || g.len() != 2 || g[0].r != g[1].r || g[0].material != g[1].material || s.walls.is_some() {
         return None;
     }
     let m = &s.materials[g[0].material];

@@ -11,16 +11,24 @@
 //! pair ([`crate::physics::material::PairMaterial::viscous_n`]) and `sqrt(m*)` per grain pair
 //! (computed once per neighbour-list build): one square root per contact and step instead
 //! of two.
+//!
+//! [`LinearRestitution`], for the linear spring ([`super::normal::Hooke`]):
+//! `gn = -2 beta sqrt(m* kn)`, `gt = -2 beta sqrt(m* kt)`, the same beta(e). The linear
+//! spring-dashpot `m* x'' + gn x' + kn x = 0` leaves contact (x = 0, the force allowed to
+//! turn attractive) after `t_c = pi / (omega_0 sqrt(1 - beta^2))`, `omega_0 = sqrt(kn/m*)`,
+//! with the rebound speed exactly e times the impact speed at every speed (LIGGGHTS
+//! `model hooke` writes the same coefficient as `sqrt(4 m* kn / (1 + (pi / ln e)^2))`).
 
-use crate::physics::lanes::Real;
+use crate::physics::contact::normal::Stiffness;
+use crate::physics::lanes::{Real, k};
 use crate::physics::material::PairMaterial;
 
 /// How the damping coefficients follow from the stiffnesses.
 pub trait Damping: Copy + Default + Send + Sync + 'static {
     const NAME: &'static str;
-    /// `(gn, gt)`, kg/s, from the pair's materials, `sqrt(m*)` (kg^1/2) and
-    /// `sqrt(R* dn)` (m).
-    fn coefficients<R: Real>(pm: &PairMaterial<R>, sqrt_m_star: R, root: R) -> (R, R);
+    /// `(gn, gt)`, kg/s, from the pair's materials, `sqrt(m*)` (kg^1/2) and the
+    /// contact's stiffnesses.
+    fn coefficients<R: Real>(pm: &PairMaterial<R>, sqrt_m_star: R, st: &Stiffness<R>) -> (R, R);
 }
 
 pub use crate::physics::material::SQRT_FIVE_SIXTHS;
@@ -31,8 +39,8 @@ pub struct Viscoelastic;
 impl Damping for Viscoelastic {
     const NAME: &'static str = "Viscoelastic";
     #[inline(always)]
-    fn coefficients<R: Real>(pm: &PairMaterial<R>, sqrt_m_star: R, root: R) -> (R, R) {
-        let s = sqrt_m_star * root.simd_sqrt();
+    fn coefficients<R: Real>(pm: &PairMaterial<R>, sqrt_m_star: R, st: &Stiffness<R>) -> (R, R) {
+        let s = sqrt_m_star * st.root.simd_sqrt();
         (pm.viscous_n * s, pm.viscous_t * s)
     }
 }
@@ -43,7 +51,21 @@ pub struct Undamped;
 impl Damping for Undamped {
     const NAME: &'static str = "Undamped";
     #[inline(always)]
-    fn coefficients<R: Real>(_: &PairMaterial<R>, _: R, _: R) -> (R, R) {
+    fn coefficients<R: Real>(_: &PairMaterial<R>, _: R, _: &Stiffness<R>) -> (R, R) {
         (R::zero(), R::zero())
+    }
+}
+
+/// The linear spring's damping, which returns the pair's restitution exactly in
+/// continuous time.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct LinearRestitution;
+
+impl Damping for LinearRestitution {
+    const NAME: &'static str = "LinearRestitution";
+    #[inline(always)]
+    fn coefficients<R: Real>(pm: &PairMaterial<R>, sqrt_m_star: R, st: &Stiffness<R>) -> (R, R) {
+        let c = k::<R>(-2.0) * pm.beta * sqrt_m_star;
+        (c * st.kn.simd_sqrt(), c * st.kt.simd_sqrt())
     }
 }

@@ -1,4 +1,4 @@
-//! Per-contact physics: the Hertz normal law, damping, tangential formulations, and
+//! Per-contact physics: the normal laws (Hertz, the linear spring), damping, tangential formulations, and
 //! their named combinations.
 
 pub mod damping;

@@ -1,5 +1,6 @@
-//! A contact model: Hertz normal force, a damping form and a tangential formulation,
-//! composed at compile time. Each named combination is one monomorphized kernel.
+//! A contact model: a normal law (Hertz or the linear spring), a damping form and a
+//! tangential formulation, composed at compile time. Each named combination is one
+//! monomorphized kernel.
 
 use std::marker::PhantomData;
 
@@ -8,8 +9,8 @@ use serde::{Deserialize, Serialize};
 
 use nalgebra::Vector2;
 
-use super::damping::{Damping, Undamped, Viscoelastic};
-use super::normal::{HertzStiffness, hertz_energy};
+use super::damping::{Damping, LinearRestitution, Undamped, Viscoelastic};
+use super::normal::{Hertz, Hooke, Normal};
 use super::tangential::{Frictionless, IncrementalForce, Tangential, TangentialForce, TangentialInput, TotalDisplacement};
 use crate::physics::dim::Vec2;
 use crate::physics::energy::{EnergyLedger, EnergySums};
@@ -223,18 +224,23 @@ impl EnergyMemory<crate::physics::lanes::Lanes> {
 
 /// A contact law: the trait the stages are generic over.
 pub trait ContactLaw: Copy + Send + Sync + 'static {
+    type Norm: Normal;
     type Damp: Damping;
     type Tang: Tangential;
     fn options(&self) -> ModelOptions;
     /// The elastic energies, normal and tangential (J), a touching contact of materials
-    /// `pm` and reduced radius `r_star` (m) stores at overlap `dn` (m) with elastic
-    /// tangential force `fte` (N) (what the ledger adds for the pairs when it is read).
-    fn stored_energy(&self, pm: &PairMaterial, r_star: f64, dn: f64, fte: Vec2) -> (f64, f64);
+    /// `pm`, reduced radius `r_star` (m) and square root of the reduced mass
+    /// `sqrt_m_star` (kg^1/2) stores at overlap `dn` (m) with elastic tangential force
+    /// `fte` (N) (what the ledger adds for the pairs when it is read).
+    fn stored_energy(&self, pm: &PairMaterial, r_star: f64, sqrt_m_star: f64, dn: f64, fte: Vec2) -> (f64, f64);
+    /// The normal law's name and parameters, for `explain` and checkpoints.
+    fn normal_label(&self) -> String;
     /// One line for `explain`.
     fn describe(&self) -> String {
         let o = self.options();
         format!(
-            "Contacts<Hertz, {}, {}{}{}>",
+            "Contacts<{}, {}, {}{}{}>",
+            self.normal_label(),
             Self::Damp::NAME,
             Self::Tang::NAME,
             if o.limit_force { ", clamp Fn>=0" } else { "" },
@@ -247,17 +253,19 @@ pub trait ContactLaw: Copy + Send + Sync + 'static {
     }
 }
 
-/// The Hertz-Mindlin contact model, composed from a damping form and a tangential
+/// A contact model, composed from a normal law, a damping form and a tangential
 /// formulation.
 #[derive(Clone, Copy, Debug)]
-pub struct ContactModel<Dm: Damping, T: Tangential> {
+pub struct ContactModel<N: Normal, Dm: Damping, T: Tangential> {
     pub options: ModelOptions,
+    /// The normal law and its parameters (nothing for Hertz).
+    pub normal: N,
     _p: PhantomData<(Dm, T)>,
 }
 
-impl<Dm: Damping, T: Tangential> ContactModel<Dm, T> {
-    pub fn new(options: ModelOptions) -> Self {
-        ContactModel { options, _p: PhantomData }
+impl<N: Normal, Dm: Damping, T: Tangential> ContactModel<N, Dm, T> {
+    pub fn new(options: ModelOptions, normal: N) -> Self {
+        ContactModel { options, normal, _p: PhantomData }
     }
 
     /// The force of a touching contact (of four, one per lane, with `R = Lanes`),
@@ -265,8 +273,8 @@ impl<Dm: Damping, T: Tangential> ContactModel<Dm, T> {
     /// for the contact alone.
     #[inline(always)]
     pub fn force<R: Real>(&self, c: &ContactInput<R>, pm: &PairMaterial<R>, h: &mut T::History<R>) -> ContactState<R> {
-        let st = HertzStiffness::new(pm.e_star, pm.g_star, c.r_star, c.dn);
-        let (gn, gt) = Dm::coefficients(pm, c.sqrt_m_star, st.root);
+        let st = self.normal.stiffness(pm, c.r_star, c.sqrt_m_star, c.dn);
+        let (gn, gt) = Dm::coefficients(pm, c.sqrt_m_star, &st);
         let vc = c.contact_velocity();
         let vn = vc.dot(&c.n);
         let elastic_n = st.kn * c.dn;
@@ -336,7 +344,7 @@ impl<Dm: Damping, T: Tangential> ContactModel<Dm, T> {
     #[inline(always)]
     fn elastic(kn: f64, kt: f64, dn: f64, fte: Vec2) -> (f64, f64) {
         let ut = if T::FRICTION && kt > 0.0 { 0.5 * fte.norm_squared() / kt } else { 0.0 };
-        (hertz_energy(kn, dn), ut)
+        (N::energy(kn, dn), ut)
     }
 
     /// A contact that was touching at the previous step and is not any more: close its
@@ -360,26 +368,42 @@ impl<Dm: Damping, T: Tangential> ContactModel<Dm, T> {
     }
 }
 
-impl<Dm: Damping, T: Tangential> ContactLaw for ContactModel<Dm, T> {
+impl<N: Normal, Dm: Damping, T: Tangential> ContactLaw for ContactModel<N, Dm, T> {
+    type Norm = N;
     type Damp = Dm;
     type Tang = T;
     fn options(&self) -> ModelOptions {
         self.options
     }
     #[inline]
-    fn stored_energy(&self, pm: &PairMaterial, r_star: f64, dn: f64, fte: Vec2) -> (f64, f64) {
-        let st = HertzStiffness::new(pm.e_star, pm.g_star, r_star, dn);
+    fn stored_energy(&self, pm: &PairMaterial, r_star: f64, sqrt_m_star: f64, dn: f64, fte: Vec2) -> (f64, f64) {
+        let st = self.normal.stiffness(pm, r_star, sqrt_m_star, dn);
         Self::elastic(st.kn, st.kt, dn, fte)
+    }
+    fn normal_label(&self) -> String {
+        self.normal.label()
     }
 }
 
 /// The named combinations grainlab compiles. A scene picks one of these; any other
 /// combination is refused with this list.
-pub type HertzFrictionless = ContactModel<Viscoelastic, Frictionless>;
-pub type HertzFrictionlessElastic = ContactModel<Undamped, Frictionless>;
+pub type HertzFrictionless = ContactModel<Hertz, Viscoelastic, Frictionless>;
+pub type HertzFrictionlessElastic = ContactModel<Hertz, Undamped, Frictionless>;
 /// LIGGGHTS `pair_style gran model hertz tangential history`.
-pub type LiggghtsHertzHistory = ContactModel<Viscoelastic, TotalDisplacement>;
-pub type LiggghtsHertzHistoryElastic = ContactModel<Undamped, TotalDisplacement>;
+pub type LiggghtsHertzHistory = ContactModel<Hertz, Viscoelastic, TotalDisplacement>;
+pub type LiggghtsHertzHistoryElastic = ContactModel<Hertz, Undamped, TotalDisplacement>;
 /// YADE `Law2_ScGeom_MindlinPhys_Mindlin` (incremental tangential force).
-pub type YadeMindlin = ContactModel<Viscoelastic, IncrementalForce>;
-pub type YadeMindlinElastic = ContactModel<Undamped, IncrementalForce>;
+pub type YadeMindlin = ContactModel<Hertz, Viscoelastic, IncrementalForce>;
+pub type YadeMindlinElastic = ContactModel<Hertz, Undamped, IncrementalForce>;
+/// The linear spring-dashpot without friction.
+pub type HookeFrictionless = ContactModel<Hooke, LinearRestitution, Frictionless>;
+pub type HookeFrictionlessElastic = ContactModel<Hooke, Undamped, Frictionless>;
+/// LIGGGHTS `pair_style gran model hooke tangential history` (and `hooke/stiffness`).
+pub type LiggghtsHookeHistory = ContactModel<Hooke, LinearRestitution, TotalDisplacement>;
+pub type LiggghtsHookeHistoryElastic = ContactModel<Hooke, Undamped, TotalDisplacement>;
+/// The linear spring with YADE's incremental tangential force (`Law2_ScGeom_FrictPhys_CundallStrack`'s history).
+pub type HookeIncremental = ContactModel<Hooke, LinearRestitution, IncrementalForce>;
+pub type HookeIncrementalElastic = ContactModel<Hooke, Undamped, IncrementalForce>;
+
+/// The names of the compiled combinations, for a refusal.
+pub const COMPILED: &str = "normal hertz or hooke (hooke_stiffness), each with damping (beta(e); the linear spring's constant-restitution form) or none (every e = 1), and tangential total_displacement, incremental_force or frictionless";

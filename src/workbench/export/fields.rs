@@ -121,6 +121,9 @@ const LIST_X: &str = "grains.data Atoms: x y (z = 0)";
 const LIST_V: &str = "grains.data Velocities: vx vy";
 const LIST_R: &str = "grains.data Atoms: diameter 2 r";
 const ATOM_TYPE: &str = "grains.data atom type (material + 1)";
+const NORMAL_Y: &str = "the linear spring (hooke, hooke_stiffness) is not exported to YADE yet: its linear laws (CundallStrack, ViscElPhys) take stiffness and damping in other terms, a mapping not yet checked against grainlab";
+const SPRING_L: &str = "`fix m5 kn`, `fix m6 kt` per pair of atom types, and the damping rates gamman, gammat = -2 beta(e) sqrt(k / m*) (LIGGGHTS multiplies them by m*)";
+const SPRING_REFUSED_L: &str = "a pair of materials that meets at more than one reduced mass (grains of two sizes, or a grain and a flat wall): hooke/stiffness takes one damping rate per pair of atom types, times m*";
 const SPIN_NO_ROTATION: &str = "a non-zero spin with model.rotation = false (and friction): grainlab's grain-grain contacts then leave the spin out of the contact velocity, LIGGGHTS (`nve`) and YADE (blocked rotation) keep the spin, which never changes, in it";
 const NOT_PHYSICS_OUTPUT: &str = "grainlab's own output";
 
@@ -238,6 +241,27 @@ pub const FIELDS: &[Field] = &[
         "gravity",
         refused("not exported yet: grainlab pulls the free grains only, and a `fix gravity` on the free group has not been checked against it"),
         refused("not exported yet: NewtonIntegrator's gravity would also pull the loaded wall's clump, which grainlab's gravity does not"),
+    ),
+    each(
+        "model.normal",
+        written("`pair_style gran model hertz` (hertz), `model hooke` (hooke), `model hooke/stiffness` (hooke_stiffness), in the pair style and the wall/gran fixes")
+            .or_refused(SPRING_REFUSED_L),
+        refused(NORMAL_Y),
+    ),
+    each(
+        "model.normal.hooke.characteristic_velocity",
+        written("`fix m5 all property/global characteristicVelocity scalar VC` (LIGGGHTS derives kn = kt from it per contact, as grainlab does)"),
+        refused(NORMAL_Y),
+    ),
+    each(
+        "model.normal.hooke_stiffness.kn",
+        written(SPRING_L).or_refused(SPRING_REFUSED_L),
+        refused(NORMAL_Y),
+    ),
+    each(
+        "model.normal.hooke_stiffness.kt",
+        written(SPRING_L).or_refused(SPRING_REFUSED_L),
+        refused(NORMAL_Y),
     ),
     each(
         "model.tangential",

@@ -22,7 +22,7 @@ use crate::physics::contact::LeverArm;
 use crate::physics::material::PairMaterial;
 use crate::engine::world::WallMotion;
 use crate::physics::walls::{Control, Surface};
-use crate::scene::{Analysis, Scene, TangentialSpec};
+use crate::scene::{Analysis, NormalLaw, Scene, TangentialSpec};
 
 pub(crate) fn deck(scene: &Scene, ex: &Exported) -> Result<String, Error> {
     let model = &scene.model;
@@ -73,7 +73,24 @@ pub(crate) fn deck(scene: &Scene, ex: &Exported) -> Result<String, Error> {
     let _ = writeln!(w, "fix m3 all property/global coefficientRestitution peratomtypepair {n} {}", pair(&|pm| pm.restitution));
     let frictionless = model.tangential == TangentialSpec::Frictionless;
     let _ = writeln!(w, "fix m4 all property/global coefficientFriction peratomtypepair {n} {}", pair(&|pm| if frictionless { 0.0 } else { pm.friction }));
-    let law = format!("model hertz tangential history{}", if model.limit_force { " limitForce on" } else { "" });
+    let style = match model.normal {
+        NormalLaw::Hertz => "hertz",
+        NormalLaw::Hooke { characteristic_velocity } => {
+            let _ = writeln!(w, "fix m5 all property/global characteristicVelocity scalar {}", f(characteristic_velocity));
+            "hooke"
+        }
+        NormalLaw::HookeStiffness { kn, kt } => {
+            let rate = spring_rates(scene, p, e.walls(), kn, kt)?;
+            let table = |g: &dyn Fn(usize, usize) -> f64| (0..n).flat_map(|a| (0..n).map(move |b| (a, b))).map(|(a, b)| f(g(a, b))).collect::<Vec<_>>().join(" ");
+            let _ = writeln!(w, "fix m5 all property/global kn peratomtypepair {n} {}", table(&|_, _| kn));
+            let _ = writeln!(w, "fix m6 all property/global kt peratomtypepair {n} {}", table(&|_, _| kt));
+            let _ = writeln!(w, "# gamman, gammat: LIGGGHTS damps with m* x these (1/s); grainlab's -2 beta(e) sqrt(k m*) is m* x -2 beta sqrt(k / m*), one m* per pair of atom types.");
+            let _ = writeln!(w, "fix m7 all property/global gamman peratomtypepair {n} {}", table(&|a, b| rate[a * n + b].0));
+            let _ = writeln!(w, "fix m8 all property/global gammat peratomtypepair {n} {}", table(&|a, b| rate[a * n + b].1));
+            "hooke/stiffness"
+        }
+    };
+    let law = format!("model {style} tangential history{}", if model.limit_force { " limitForce on" } else { "" });
     let _ = writeln!(w, "pair_style gran {law}\npair_coeff * *");
     let _ = writeln!(w, "timestep {}", f(info.time_step_s));
     let _ = writeln!(w, "group free id <> 1 {}", p.n_free);
@@ -264,3 +281,72 @@ pub(crate) fn name_of<T: serde::Serialize>(v: &T) -> String {
     }
 }
 
+
+/// `model hooke/stiffness` damps a contact with `m* gamma_n` for one `gamma_n` per pair of
+/// atom types (1/s); grainlab's `-2 beta(e) sqrt(kn m*)` is that with
+/// `gamma_n = -2 beta sqrt(kn / m*)`, which one number per pair of types expresses only
+/// when every contact the pair can make has one reduced mass m*. The (gamma_n, gamma_t)
+/// of each pair of types (materials), row by row; a pair that meets at two reduced masses
+/// is refused naming `model.normal.hooke_stiffness.kn` (and kt).
+fn spring_rates(scene: &Scene, p: &crate::physics::particles::Particles, walls: &[crate::physics::walls::Wall], kn: f64, kt: f64) -> Result<Vec<(f64, f64)>, Error> {
+    let n = scene.materials.len();
+    // The masses of each material's free grains and glued grains (to 1e-12), with how
+    // many free grains have each.
+    let mut free: Vec<Vec<(f64, usize)>> = vec![Vec::new(); n];
+    let mut glued: Vec<Vec<(f64, usize)>> = vec![Vec::new(); n];
+    let same = |x: f64, m: f64| (x - m).abs() <= 1e-12 * m;
+    for k in 0..p.len() {
+        let list = if k < p.n_free { &mut free[p.material[k] as usize] } else { &mut glued[p.material[k] as usize] };
+        match list.iter_mut().find(|(x, _)| same(*x, p.m[k])) {
+            Some((_, c)) => *c += 1,
+            None => list.push((p.m[k], 1)),
+        }
+    }
+    let mut stars: Vec<Vec<f64>> = vec![Vec::new(); n * n];
+    let mut add = |a: usize, b: usize, m: f64| {
+        for (x, y) in [(a, b), (b, a)] {
+            if !stars[x * n + y].iter().any(|&s| same(s, m)) {
+                stars[x * n + y].push(m);
+            }
+        }
+    };
+    for a in 0..n {
+        for (ka, &(ma, ca)) in free[a].iter().enumerate() {
+            // Free grains of this and the later materials (a grain does not touch itself).
+            for b in a..n {
+                for (kb, &(mb, _)) in free[b].iter().enumerate() {
+                    if b > a || kb > ka || (kb == ka && ca > 1) {
+                        add(a, b, crate::physics::material::reduced(ma, mb));
+                    }
+                }
+            }
+            for (b, g) in glued.iter().enumerate() {
+                for &(mb, _) in g {
+                    add(a, b, crate::physics::material::reduced(ma, mb));
+                }
+            }
+            for wall in walls.iter().filter(|w| w.is_flat()) {
+                add(a, wall.material, ma);
+            }
+        }
+    }
+    let mut out = vec![(0.0, 0.0); n * n];
+    for a in 0..n {
+        for b in 0..n {
+            let m = &stars[a * n + b];
+            if m.len() > 1 {
+                return Err(refuse(
+                    Code::Liggghts,
+                    "model.normal.hooke_stiffness.kn",
+                    kn,
+                    &format!("with model.normal.hooke_stiffness.kt = {kt}: materials[{a}] meet materials[{b}] at reduced masses {:e} kg and {:e} kg (grains of two sizes, or a grain and a flat wall)", m[0], m[1]),
+                ));
+            }
+            if let Some(&m) = m.first() {
+                let beta = PairMaterial::mix(&scene.materials[a], &scene.materials[b]).beta;
+                out[a * n + b] = (-2.0 * beta * (kn / m).sqrt(), -2.0 * beta * (kt / m).sqrt());
+            }
+        }
+    }
+    Ok(out)
+}

@@ -24,6 +24,11 @@ use crate::physics::walls::{Control, Surface};
 use crate::scene::{Analysis, Scene, TangentialSpec};
 
 pub(crate) fn deck(scene: &Scene, ex: &Exported) -> Result<String, Error> {
+    match scene.model.normal {
+        crate::scene::NormalLaw::Hertz => {}
+        crate::scene::NormalLaw::Hooke { characteristic_velocity } => return Err(refuse(Code::Yade, "model.normal.hooke.characteristic_velocity", characteristic_velocity, "")),
+        crate::scene::NormalLaw::HookeStiffness { kn, kt } => return Err(refuse(Code::Yade, "model.normal.hooke_stiffness.kn", kn, &format!("with model.normal.hooke_stiffness.kt = {kt}"))),
+    }
     let model = &scene.model;
     let mats = &scene.materials;
     if let Some(k) = mats.iter().position(|m| m.restitution != mats[0].restitution) {
