@@ -85,6 +85,7 @@ pub fn cases() -> Vec<Case> {
             }
         }
     }
+    linear_spring_cases(&mut out);
     let mut s = builtin::shear();
     s.model.lever_arm = LeverArm::RadiusMinusHalfOverlap;
     s.name = "shear-liggghts".into();
@@ -128,6 +129,55 @@ pub fn cases() -> Vec<Case> {
         }
     }
     out
+}
+
+/// The linear spring's stiffnesses in the `hooke-*` cases that give them (LIGGGHTS
+/// `model hooke/stiffness`), N/m: for 1 mm glass beads a contact time of about 7 us,
+/// near the Hertz one at 1 m/s.
+pub const SPRING_KN: f64 = 2.0e5;
+pub const SPRING_KT: f64 = 1.5e5;
+
+/// The linear spring against LIGGGHTS (`model hooke` and `hooke/stiffness`, tangential
+/// history, its lever arm): a head-on restitution grid for both forms (e = 0.1, 0.5, 0.9;
+/// t_c/50 and t_c/500; with and without the clamp), oblique impacts on a flat wall
+/// (derived stiffness: the wall contact has R* = r, m* = m) and on a resting grain (given
+/// stiffness), and the shear cell (derived stiffness).
+fn linear_spring_cases(out: &mut Vec<Case>) {
+    use crate::scene::NormalLaw;
+    let forms = [("derived", NormalLaw::Hooke { characteristic_velocity: 1.0 }), ("given", NormalLaw::HookeStiffness { kn: SPRING_KN, kt: SPRING_KT })];
+    for (tag, law) in forms {
+        for e in [0.1, 0.5, 0.9] {
+            for n in [50.0, 500.0] {
+                for clamp in [false, true] {
+                    let mut s = builtin::head_on_under(law, glass(e), 1e-3, 1.0, n);
+                    s.model.limit_force = clamp;
+                    s.model.lever_arm = LeverArm::RadiusMinusHalfOverlap;
+                    let name = format!("hooke-restitution/{tag}-e{}-n{}-{}", num(e), num(n), if clamp { "clamp" } else { "free" });
+                    s.name = name.replace('/', "-");
+                    s.description = format!("head-on glass beads r = 1 mm on the linear spring ({tag} stiffness), e = {e}, v = 1 m/s, dt = t_c/{n}, Fn clamp {}", if clamp { "on" } else { "off" });
+                    let curve = n == 500.0 && e == 0.5 && !clamp;
+                    out.push(Case { info: CaseInfo { name, description: s.description.clone(), codes: vec![Code::Liggghts], quick: true, curve, ensemble: None }, scene: s });
+                }
+            }
+        }
+    }
+    for &a in &ANGLES {
+        for (target, law) in [("wall", forms[0].1), ("pair", forms[1].1)] {
+            let mut s = if target == "wall" { oblique_wall(a, TangentialSpec::TotalDisplacement) } else { oblique_pair(a, TangentialSpec::TotalDisplacement) };
+            s.model.normal = law;
+            let name = format!("hooke-oblique-{target}/history-a{}", num(a));
+            s.name = name.replace('/', "-");
+            s.description = format!("{} on the linear spring ({} stiffness)", s.description, if target == "wall" { "derived" } else { "given" });
+            out.push(Case { info: CaseInfo { name, description: s.description.clone(), codes: vec![Code::Liggghts], quick: a == 45.0, curve: false, ensemble: None }, scene: s });
+        }
+    }
+    let mut s = builtin::shear();
+    s.model.lever_arm = LeverArm::RadiusMinusHalfOverlap;
+    s.model.normal = NormalLaw::Hooke { characteristic_velocity: 1.0 };
+    s.name = "hooke-shear-liggghts".into();
+    s.description = "the shear cell (built-in `shear`) on the linear spring (LIGGGHTS `model hooke`, vc = 1 m/s) with LIGGGHTS' lever arm".into();
+    s.output.frames = 0;
+    out.push(Case { info: CaseInfo { name: "hooke-shear/liggghts".into(), description: s.description.clone(), codes: vec![Code::Liggghts], quick: false, curve: false, ensemble: None }, scene: s });
 }
 
 /// The packing seeds of the workbench's shear ensembles.

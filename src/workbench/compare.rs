@@ -186,7 +186,7 @@ pub fn compare_case(case_dir: &Path) -> Result<Vec<Row>, Error> {
             } else {
                 (engine_impact(&scene)?, None)
             };
-            let oblique = case.name.starts_with("oblique");
+            let oblique = case.name.contains("oblique");
             for code in codes {
                 rows.extend(compare_impact(&case.name, code, &e, &expected_impact(case_dir, code)?, oblique));
                 // The force-overlap curve on a common normalised grid (50 overlaps per
