@@ -1,0 +1,92 @@
+"""Plots and the results table of docs/benchmarks.md from the rows tests/chung_ooi.rs wrote
+(one CSV per test in the folder given): grainlab's values as points, the closed forms as
+lines, for the sphere in the plane and for disks."""
+import csv, os, sys
+
+import matplotlib
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+OUT = os.path.join(ROOT, "docs", "benchmarks")
+rows_dir = sys.argv[1]
+os.makedirs(OUT, exist_ok=True)
+
+
+def rows(test):
+    return list(csv.DictReader(open(os.path.join(rows_dir, f"{test}.csv"))))
+
+
+SHAPES = [("sphere_in_plane", "sphere in the plane", "o"), ("disk", "disk", "s")]
+FORMS = [("total_displacement", "C0"), ("incremental_force", "C3")]
+
+
+def series(rs, shape, form, quantity):
+    pts = sorted((float(r["x"]), float(r["grainlab"]), float(r["closed_form"]) if r["closed_form"] else None) for r in rs if r["shape"] == shape and r["form"] == form and r["quantity"] == quantity)
+    return pts
+
+
+# Test 3: realised against input restitution.
+fig, ax = plt.subplots(figsize=(5, 4))
+t3 = rows("test_3")
+for (shape, label, marker) in SHAPES:
+    for mat, color in [("Al2O3", "C0"), ("cast_iron", "C1")]:
+        p = series(t3, shape, mat, "restitution_normal")
+        ax.plot([x for x, _, _ in p], [y for _, y, _ in p], marker, mfc="none", color=color, label=f"{mat.replace('_', ' ')}, {label}")
+ax.plot([0, 1], [0, 1], "k-", lw=0.8, label="input e (closed form)")
+ax.set_xlabel("input e")
+ax.set_ylabel("realised e")
+ax.set_title("Test 3: restitution on a rigid plane (t_c/1000, no clamp)")
+ax.legend(fontsize=7)
+fig.tight_layout()
+fig.savefig(os.path.join(OUT, "test_3.png"), dpi=110)
+
+# Test 4: tangential restitution and rebound spin against angle.
+fig, axes = plt.subplots(1, 2, figsize=(10, 4))
+t4 = rows("test_4")
+for ax, q, ylabel in [(axes[0], "tangential_restitution", "tangential restitution e_t"), (axes[1], "spin_r_over_v", "rebound spin w r / v")]:
+    for (shape, label, marker) in SHAPES:
+        for form, color in FORMS:
+            p = series(t4, shape, form, q)
+            ax.plot([x for x, _, _ in p], [y for _, y, _ in p], marker, mfc="none", color=color, ms=5, label=f"{form.replace('_', ' ')}, {label}")
+            c = [(x, cf) for x, _, cf in p if cf is not None]
+            if form == "total_displacement":
+                ax.plot([x for x, _ in c], [y for _, y in c], "-", color="k" if shape == "disk" else "0.5", lw=0.8, label=f"gross sliding (closed form), {label}")
+    ax.set_xlabel("impact angle from the normal, degrees")
+    ax.set_ylabel(ylabel)
+axes[0].legend(fontsize=6)
+fig.suptitle("Test 4: Al2O3 on a rigid plane at 3.9 m/s, e = 0.98, mu = 0.092 (clamp on)")
+fig.tight_layout()
+fig.savefig(os.path.join(OUT, "test_4.png"), dpi=110)
+
+# Test 6: rebound tangential velocity and spin against the initial spin.
+fig, axes = plt.subplots(1, 2, figsize=(10, 4))
+t6 = rows("test_6")
+for ax, q, ylabel in [(axes[0], "vt_over_vn", "rebound tangential velocity / vn"), (axes[1], "spin_r_over_vn", "rebound spin w r / vn")]:
+    for (shape, label, marker) in SHAPES:
+        for form, color in FORMS:
+            p = series(t6, shape, form, q)
+            ax.plot([x for x, _, _ in p], [y for _, y, _ in p], marker, mfc="none", color=color, ms=6, label=f"{form.replace('_', ' ')}, {label}")
+            if form == "total_displacement":
+                ax.plot([x for x, _, _ in p], [c for _, _, c in p], "x", color="k", ms=8, label=f"gross sliding (closed form), {label}")
+    ax.set_xlabel("initial spin w0 r / vn")
+    ax.set_ylabel(ylabel)
+axes[0].legend(fontsize=6)
+fig.suptitle("Test 6: Al on a rigid plane, vn = 0.2 m/s, e = 0.5, mu = 0.4 (clamp on)")
+fig.tight_layout()
+fig.savefig(os.path.join(OUT, "test_6.png"), dpi=110)
+
+# Tests 1 and 2: a table.
+table = ["| test | material | shape | quantity | grainlab | closed form | difference |", "|---|---|---|---|---:|---:|---:|"]
+names = {"test_1": {1.0: "glass", 2.0: "limestone"}, "test_2": {1.0: "Al", 2.0: "Mg"}}
+for test in ("test_1", "test_2"):
+    for r in rows(test):
+        g, c = float(r["grainlab"]), float(r["closed_form"])
+        table.append(f"| {test[-1]} | {names[test][float(r['x'])]} | {r['shape'].replace('_', ' ')} | {r['quantity']} | {g:.6g} | {c:.6g} | {abs(g - c) / abs(c):.1e} |")
+md_path = os.path.join(ROOT, "docs", "benchmarks.md")
+md = open(md_path).read()
+start, end = "<!-- results: scripts/benchmark-docs -->", "<!-- /results -->"
+i, j = md.index(start) + len(start), md.index(end)
+md = md[:i] + "\n" + "\n".join(table) + "\n" + md[j:]
+open(md_path, "w").write(md)
+print("wrote docs/benchmarks.md and docs/benchmarks/test_3.png, test_4.png, test_6.png")
