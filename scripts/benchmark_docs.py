@@ -41,6 +41,14 @@ ax.legend(fontsize=7)
 fig.tight_layout()
 fig.savefig(os.path.join(OUT, "test_3.png"), dpi=110)
 
+def reference(case, code):
+    """A committed reference run's impact summary (reference/cases/chung-ooi), or None."""
+    path = os.path.join(ROOT, "reference", "cases", "chung-ooi", case, "expected", code, "impact.csv")
+    return next(csv.DictReader(open(path)), None) if os.path.exists(path) else None
+
+
+CODES = [("liggghts", "history", "LIGGGHTS 3.8.0 (history; no clamp, arm r - dn/2)", "C0"), ("yade", "incremental", "YADE 2023.02a (Mindlin; clamp, its kinematics)", "C3")]
+
 # Test 4: tangential restitution and rebound spin against angle.
 fig, axes = plt.subplots(1, 2, figsize=(10, 4))
 t4 = rows("test_4")
@@ -52,6 +60,11 @@ for ax, q, ylabel in [(axes[0], "tangential_restitution", "tangential restitutio
             c = [(x, cf) for x, _, cf in p if cf is not None]
             if form == "total_displacement":
                 ax.plot([x for x, _ in c], [y for _, y in c], "-", color="k" if shape == "disk" else "0.5", lw=0.8, label=f"gross sliding (closed form), {label}")
+    for code, tag, label, color in CODES:
+        pts = [(a, reference(f"test4-{tag}-a{a}", code)) for a in range(5, 90, 10)]
+        key = {"tangential_restitution": lambda r: float(r["restitution_tangential"]), "spin_r_over_v": lambda r: float(r["rebound_spin_rad_s"]) * 2.5e-3 / 3.9}[q]
+        pts = [(a, key(r)) for a, r in pts if r]
+        ax.plot([a for a, _ in pts], [y for _, y in pts], "+", color=color, ms=9, label=f"{label}, sphere in the plane")
     ax.set_xlabel("impact angle from the normal, degrees")
     ax.set_ylabel(ylabel)
 axes[0].legend(fontsize=6)
@@ -69,6 +82,11 @@ for ax, q, ylabel in [(axes[0], "vt_over_vn", "rebound tangential velocity / vn"
             ax.plot([x for x, _, _ in p], [y for _, y, _ in p], marker, mfc="none", color=color, ms=6, label=f"{form.replace('_', ' ')}, {label}")
             if form == "total_displacement":
                 ax.plot([x for x, _, _ in p], [c for _, _, c in p], "x", color="k", ms=8, label=f"gross sliding (closed form), {label}")
+    for code, tag, label, color in CODES:
+        pts = [(w, reference(f"test6-{tag}-w{w}", code)) for w in (-10, -4, 3, 5, 10)]
+        key = {"vt_over_vn": lambda r: float(r["rebound_tangential_velocity_m_s"]) / 0.2, "spin_r_over_vn": lambda r: float(r["rebound_spin_rad_s"]) * 0.1 / 0.2}[q]
+        pts = [(w, key(r)) for w, r in pts if r]
+        ax.plot([w for w, _ in pts], [y for _, y in pts], "+", color=color, ms=9, label=f"{label}, sphere in the plane")
     ax.set_xlabel("initial spin w0 r / vn")
     ax.set_ylabel(ylabel)
 axes[0].legend(fontsize=6)

@@ -4,10 +4,9 @@
 //!
 //! Inputs as public implementations state them (Kratos DEMApplication's
 //! `DEM3D_chung_ooi_tests`, YADE's example scripts, LAMMPS' `unittest/granular`), see
-//! docs/benchmarks.md. A "rigid plane" is a flat wall of a material 1e30 Pa stiff: E* and
-//! G* then differ from the grain's own E/(1 - nu^2) and E/(2(2 - nu)(1 + nu)) by 1e-19
-//! relative. The wall's restitution is 1 and its friction 1e3, so that the pair takes the
-//! grain's (the smaller of the two).
+//! docs/benchmarks.md. A "rigid plane" is a flat wall of a material 1e30 Pa stiff
+//! ([`builtin::on_rigid_plane`]): E* and G* then differ from the grain's own E/(1 - nu^2)
+//! and E/(2(2 - nu)(1 + nu)) by 1e-19 relative.
 //!
 //! Gross sliding: while a contact slides, both tangential formulations give a tangential
 //! force of exactly mu |Fn| (no damping), along the tangent line. With the normal force
@@ -34,27 +33,11 @@ fn shapes() -> [(GrainShape, f64); 2] {
     [(GrainShape::SphereInPlane, 2.5), (GrainShape::Disk { thickness: 1e-3 }, 2.0)]
 }
 
-/// A grain of radius `r` about to hit a rigid plane (y = 0) with normal speed `vn`,
-/// tangential velocity `vt` (along +x) and spin `omega`, 10.5 steps of t_c/`steps` before
-/// contact (t_c the Hertz contact time of the grain on the plane at vn).
+/// [`builtin::on_rigid_plane`] with the clamp as given and the torque arm r (the closed
+/// forms' lever).
 #[allow(clippy::too_many_arguments)]
 fn on_plane(grain: Material, shape: GrainShape, r: f64, vn: f64, vt: f64, omega: f64, steps: f64, tangential: TangentialSpec, clamp: bool) -> Scene {
-    let mut s = builtin::oblique(grain.clone(), r, vn, 0.0, tangential, steps);
-    let rigid = Material { name: "rigid".into(), youngs_modulus: 1e30, restitution: 1.0, friction: 1e3, ..grain.clone() };
-    let m = shape.mass(r, grain.density);
-    let pm = PairMaterial::mix(&grain, &rigid);
-    let tc = hertz_contact_time(m, r, pm.e_star, vn);
-    let dt = tc / steps;
-    let gap = 10.5 * vn * dt;
-    s.materials = vec![grain, rigid];
-    s.grain_shape = shape;
-    s.grains = Grains::List(vec![GrainSpec { x: [0.0, r + gap], v: [vt, -vn], omega, r, material: 0 }]);
-    let w = s.walls.as_mut().unwrap();
-    w.bottom.material = 1;
-    w.top.material = 1;
-    w.top.y = Some(100.0 * r);
-    s.time_step.rule = TimeStepRule::Fixed { dt };
-    s.duration = 2.0 * gap / vn + 3.0 * tc;
+    let mut s = builtin::on_rigid_plane(grain, shape, r, vn, vt, omega, steps, tangential);
     s.model.limit_force = clamp;
     s.model.lever_arm = grainlab::physics::contact::LeverArm::Radius;
     s

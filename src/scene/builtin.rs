@@ -84,6 +84,36 @@ pub fn oblique(material: Material, r: f64, v: f64, angle_deg: f64, tangential: T
     s
 }
 
+/// A grain of `shape` and radius `r` about to hit a rigid plane (a flat bottom wall at
+/// y = 0) with normal speed `vn` (m/s), tangential velocity `vt` (m/s, along +x) and spin
+/// `omega` (rad/s), 10.5 steps of t_c/`steps` before contact, t_c the Hertz contact time of
+/// the grain on the plane at vn: the impacts of Chung & Ooi (2011) (tests/chung_ooi.rs,
+/// the workbench's `chung-ooi` cases). "Rigid" is a wall material 1e30 Pa stiff (E* and G*
+/// are the grain's own to 1e-19) of the grain's restitution and friction 1e3, so that the
+/// pair takes the grain's values (the smaller of the two). The top wall is 100 r away.
+#[allow(clippy::too_many_arguments)]
+pub fn on_rigid_plane(grain: Material, shape: crate::physics::dim::GrainShape, r: f64, vn: f64, vt: f64, omega: f64, steps: f64, tangential: TangentialSpec) -> Scene {
+    let mut s = oblique(grain.clone(), r, vn, 0.0, tangential, steps);
+    let rigid = Material { name: "rigid".into(), youngs_modulus: 1e30, friction: 1e3, ..grain.clone() };
+    let m = shape.mass(r, grain.density);
+    let pm = crate::physics::material::PairMaterial::mix(&grain, &rigid);
+    let tc = crate::physics::material::hertz_contact_time(m, r, pm.e_star, vn);
+    let dt = tc / steps;
+    let gap = 10.5 * vn * dt;
+    s.name = "plane-impact".into();
+    s.description = format!("a grain of radius {r} m on a rigid plane at vn = {vn} m/s, vt = {vt} m/s, spin {omega} rad/s");
+    s.materials = vec![grain, rigid];
+    s.grain_shape = shape;
+    s.grains = Grains::List(vec![GrainSpec { x: [0.0, r + gap], v: [vt, -vn], omega, r, material: 0 }]);
+    let w = s.walls.as_mut().expect("oblique has walls");
+    w.bottom.material = 1;
+    w.top.material = 1;
+    w.top.y = Some(100.0 * r);
+    s.time_step.rule = TimeStepRule::Fixed { dt };
+    s.duration = 2.0 * gap / vn + 3.0 * tc;
+    s
+}
+
 /// A grain of radius `r` hitting a resting twin at speed `v`, `angle_deg` between its
 /// velocity and the line of centres at contact. It starts 10.5 steps before contact.
 pub fn oblique_pair(material: Material, r: f64, v: f64, angle_deg: f64, tangential: TangentialSpec, steps_per_contact: f64) -> Scene {

@@ -86,6 +86,7 @@ pub fn cases() -> Vec<Case> {
         }
     }
     linear_spring_cases(&mut out);
+    chung_ooi_cases(&mut out);
     let mut s = builtin::shear();
     s.model.lever_arm = LeverArm::RadiusMinusHalfOverlap;
     s.name = "shear-liggghts".into();
@@ -178,6 +179,37 @@ fn linear_spring_cases(out: &mut Vec<Case>) {
     s.description = "the shear cell (built-in `shear`) on the linear spring (LIGGGHTS `model hooke`, vc = 1 m/s) with LIGGGHTS' lever arm".into();
     s.output.frames = 0;
     out.push(Case { info: CaseInfo { name: "hooke-shear/liggghts".into(), description: s.description.clone(), codes: vec![Code::Liggghts], quick: false, curve: false, ensemble: None }, scene: s });
+}
+
+/// Chung & Ooi (2011)'s tests 4 and 6 (docs/benchmarks.md) in the reference codes, each
+/// formulation with the code that uses it and that code's settings ([`matched`]): test 4,
+/// an Al2O3 grain (R = 2.5 mm, e = 0.98, mu = 0.092) on a rigid plane at 3.9 m/s, 5 to 85
+/// degrees from the normal; test 6, an Al grain (R = 0.1 m, e = 0.5, mu = 0.4) at
+/// vn = 0.2 m/s with spin w0 r / vn from -10 to 10. Sphere in the plane, t_c/500.
+fn chung_ooi_cases(out: &mut Vec<Case>) {
+    use crate::physics::dim::GrainShape;
+    let al2o3 = Material { name: "Al2O3".into(), youngs_modulus: 380e9, poisson_ratio: 0.23, density: 4000.0, restitution: 0.98, friction: 0.092 };
+    let al = Material { name: "Al".into(), youngs_modulus: 70e9, poisson_ratio: 0.33, density: 2700.0, restitution: 0.5, friction: 0.4 };
+    for (form, code) in [(TangentialSpec::TotalDisplacement, Code::Liggghts), (TangentialSpec::IncrementalForce, Code::Yade)] {
+        let tag = if code == Code::Liggghts { "history" } else { "incremental" };
+        for a in [5.0f64, 15.0, 25.0, 35.0, 45.0, 55.0, 65.0, 75.0, 85.0] {
+            let t = a.to_radians();
+            let mut s = builtin::on_rigid_plane(al2o3.clone(), GrainShape::SphereInPlane, 2.5e-3, 3.9 * t.cos(), 3.9 * t.sin(), 0.0, 500.0, form);
+            matched(&mut s, form);
+            let name = format!("chung-ooi/test4-{tag}-a{}", num(a));
+            s.name = name.replace('/', "-");
+            s.description = format!("Chung & Ooi test 4: Al2O3 grain (R = 2.5 mm, e = 0.98, mu = 0.092) on a rigid plane at 3.9 m/s, {a} deg from the normal, t_c/500");
+            out.push(Case { info: CaseInfo { name, description: s.description.clone(), codes: vec![code], quick: a == 45.0, curve: false, ensemble: None }, scene: s });
+        }
+        for ratio in [-10.0, -4.0, 3.0, 5.0, 10.0] {
+            let mut s = builtin::on_rigid_plane(al.clone(), GrainShape::SphereInPlane, 0.1, 0.2, 0.0, ratio * 0.2 / 0.1, 500.0, form);
+            matched(&mut s, form);
+            let name = format!("chung-ooi/test6-{tag}-w{}", num(ratio));
+            s.name = name.replace('/', "-");
+            s.description = format!("Chung & Ooi test 6: Al grain (R = 0.1 m, e = 0.5, mu = 0.4) on a rigid plane at vn = 0.2 m/s with spin w0 r / vn = {ratio}, t_c/500");
+            out.push(Case { info: CaseInfo { name, description: s.description.clone(), codes: vec![code], quick: ratio == 5.0, curve: false, ensemble: None }, scene: s });
+        }
+    }
 }
 
 /// The packing seeds of the workbench's shear ensembles.

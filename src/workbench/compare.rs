@@ -186,7 +186,8 @@ pub fn compare_case(case_dir: &Path) -> Result<Vec<Row>, Error> {
             } else {
                 (engine_impact(&scene)?, None)
             };
-            let oblique = case.name.contains("oblique");
+            // Tangential outcomes too where the impact has a tangential part.
+            let oblique = case.name.contains("oblique") || case.name.starts_with("chung-ooi");
             for code in codes {
                 rows.extend(compare_impact(&case.name, code, &e, &expected_impact(case_dir, code)?, oblique));
                 // The force-overlap curve on a common normalised grid (50 overlaps per
