@@ -40,7 +40,8 @@ fn neighbour_rebuild(c: &mut Criterion) {
 }
 
 fn contact_kernel(c: &mut Criterion) {
-    use grainlab::physics::contact::model::{LiggghtsHertzHistory, YadeMindlin};
+    use grainlab::physics::contact::model::{LiggghtsHertzHistory, LiggghtsHookeHistory, YadeMindlin};
+    use grainlab::physics::contact::normal::{Hertz, Hooke};
     use grainlab::physics::contact::{ContactHistory, ContactInput, LeverArm, ModelOptions};
     use grainlab::physics::dim::Vec2;
     use grainlab::physics::material::{Material, PairMaterial};
@@ -60,7 +61,7 @@ fn contact_kernel(c: &mut Criterion) {
     };
     let options = ModelOptions { limit_force: false, lever_arm: LeverArm::Radius };
     let mut ledger = EnergyLedger::default();
-    let l = LiggghtsHertzHistory::new(options);
+    let l = LiggghtsHertzHistory::new(options, Hertz);
     let mut h = ContactHistory::default();
     c.bench_function("contact_kernel_liggghts_history", |b| b.iter(|| l.touch::<false>(black_box(&input), &pm, &mut h, &mut ledger)));
     // Four such contacts at once in SIMD lanes (one iteration = four contacts).
@@ -83,9 +84,15 @@ fn contact_kernel(c: &mut Criterion) {
         let mut h = <grainlab::physics::contact::tangential::TotalDisplacement as grainlab::physics::contact::tangential::Tangential>::gather([&xi; 4]);
         c.bench_function("contact_kernel_liggghts_history_four_lanes", |b| b.iter(|| l.force(black_box(&lanes), &pml, &mut h)));
     }
-    let y = YadeMindlin::new(options);
+    let y = YadeMindlin::new(options, Hertz);
     let mut h = ContactHistory::default();
     c.bench_function("contact_kernel_yade_mindlin", |b| b.iter(|| y.touch::<false>(black_box(&input), &pm, &mut h, &mut ledger)));
+    // The linear spring, derived per pair (a fifth root per contact) and given.
+    for (name, spring) in [("contact_kernel_hooke_derived", Hooke::Derived { vc: 1.0 }), ("contact_kernel_hooke_given", Hooke::Given { kn: 2e5, kt: 1.5e5 })] {
+        let k = LiggghtsHookeHistory::new(options, spring);
+        let mut h = ContactHistory::default();
+        c.bench_function(name, |b| b.iter(|| k.touch::<false>(black_box(&input), &pm, &mut h, &mut ledger)));
+    }
 }
 
 criterion_group!(benches, contact_kernel, shear_step, neighbour_rebuild);

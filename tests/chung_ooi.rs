@@ -233,7 +233,7 @@ fn test_4_oblique_impacts_at_constant_speed() {
     for form in [TangentialSpec::TotalDisplacement, TangentialSpec::IncrementalForce] {
         for (shape, kappa) in shapes() {
             for a in (1..=17).map(|k| 5.0 * k as f64) {
-                let t = (a as f64).to_radians();
+                let t = a.to_radians();
                 let s = on_plane(mat.clone(), shape, 2.5e-3, 3.9 * t.cos(), 3.9 * t.sin(), 0.0, 500.0, form, true);
                 let (imp, _) = run(&s);
                 let what = format!("{form:?} {shape:?} {a} deg");

@@ -464,8 +464,9 @@ impl Parts<'_> {
         };
         // The force stages, shared by the step and by the set-up at t = 0.
         let threads = self.threads.clone();
-        let forces = || -> Result<Vec<Box<dyn Stage<L<N, Dm, T>>>>, Error> {
-            let mut s: Vec<Box<dyn Stage<L<N, Dm, T>>>> = vec![Box::new(UpdateNeighbours), Box::new(ClearForces)];
+        type Stages<N, Dm, T> = Vec<Box<dyn Stage<L<N, Dm, T>>>>;
+        let forces = || -> Result<Stages<N, Dm, T>, Error> {
+            let mut s: Stages<N, Dm, T> = vec![Box::new(UpdateNeighbours), Box::new(ClearForces)];
             if pulled {
                 s.push(Box::new(Gravity::<E>));
             }
@@ -481,7 +482,7 @@ impl Parts<'_> {
             }
             Ok(s)
         };
-        let mut stages: Vec<Box<dyn Stage<L<N, Dm, T>>>> = Vec::new();
+        let mut stages: Stages<N, Dm, T> = Vec::new();
         // The walls first: their grains follow them in the drift.
         if has_walls {
             stages.push(Box::new(MoveWalls));

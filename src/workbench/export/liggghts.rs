@@ -313,8 +313,8 @@ fn spring_rates(scene: &Scene, p: &crate::physics::particles::Particles, walls: 
     for a in 0..n {
         for (ka, &(ma, ca)) in free[a].iter().enumerate() {
             // Free grains of this and the later materials (a grain does not touch itself).
-            for b in a..n {
-                for (kb, &(mb, _)) in free[b].iter().enumerate() {
+            for (b, fb) in free.iter().enumerate().skip(a) {
+                for (kb, &(mb, _)) in fb.iter().enumerate() {
                     if b > a || kb > ka || (kb == ka && ca > 1) {
                         add(a, b, crate::physics::material::reduced(ma, mb));
                     }
