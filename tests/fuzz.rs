@@ -120,6 +120,15 @@ fn bases(dir: &Path) -> Vec<Value> {
     seed["materials"].as_array_mut().unwrap().push(json!({"name": "steel", "youngs_modulus": 2e11, "poisson_ratio": 0.3, "density": 7800.0, "restitution": 0.8, "friction": 0.2}));
     seed["grains"]["list"][1]["material"] = 1.into();
     out.push(seed);
+    // The linear spring: derived per pair in the shear cell (under load, between rough
+    // walls), given on a pair of grains with the seed's time-step rule.
+    let mut spring_shear = json(&shear);
+    spring_shear["model"]["normal"] = json!({"hooke": {"characteristic_velocity": 0.5}});
+    out.push(spring_shear);
+    let mut spring_pair = json(&builtin::oblique_pair(grainlab::physics::material::Material::default(), 1e-3, 1.0, 30.0, grainlab::scene::TangentialSpec::TotalDisplacement, 50.0));
+    spring_pair["model"]["normal"] = json!({"hooke_stiffness": {"kn": 2e5, "kt": 1.5e5}});
+    spring_pair["time_step"]["rule"] = json!({"seed_rule": {"factor": 0.1, "reference_overlap": 0.01}});
+    out.push(spring_pair);
     out
 }
 
