@@ -34,9 +34,6 @@ pub struct Stiffness<R = f64> {
     pub root: R,
 }
 
-/// The Hertz stiffnesses (the name the rest of the crate has used).
-pub type HertzStiffness<R = f64> = Stiffness<R>;
-
 impl<R: Real> Stiffness<R> {
     /// The Hertz-Mindlin stiffnesses of moduli `e_star`, `g_star` (Pa), reduced radius
     /// `r_star` (m) at overlap `dn` (m).
