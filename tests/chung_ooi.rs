@@ -70,9 +70,8 @@ fn pair(a: (f64, Material), b: (f64, Material), shape: GrainShape, v: f64, vy0: 
     s
 }
 
-fn run(s: &Scene) -> (ImpactSummary, grainlab::output::summary::Summary) {
-    let out = run_scene(s, &RunOptions::default()).expect("the run completes");
-    (out.impact.expect("the impact completed"), out)
+fn run(s: &Scene) -> ImpactSummary {
+    run_scene(s, &RunOptions::default()).expect("the run completes").impact.expect("the impact completed")
 }
 
 /// With `CHUNG_OOI_OUT` set (scripts/benchmark-docs), each test writes its rows there as
@@ -149,7 +148,7 @@ fn test_1_two_equal_spheres_head_on_follow_hertz() {
         for (shape, _) in shapes() {
             let r = 0.01;
             let s = pair((r, mat.clone()), (r, mat.clone()), shape, 20.0, 0.0, [0.0, 0.0], 400.0, false);
-            let (imp, _) = run(&s);
+            let imp = run(&s);
             let m = shape.mass(r, mat.density);
             let k = if name == "glass" { 1.0 } else { 2.0 };
             hertz_rows(&mut rows, shape, k, &imp, m / 2.0, r / 2.0, PairMaterial::mix(&mat, &mat).e_star, 20.0);
@@ -167,7 +166,7 @@ fn test_2_a_sphere_on_a_rigid_plane_follows_hertz() {
         for (shape, _) in shapes() {
             let r = 0.1;
             let s = on_plane(mat.clone(), shape, r, 0.2, 0.0, 0.0, 400.0, TangentialSpec::Frictionless, false);
-            let (imp, _) = run(&s);
+            let imp = run(&s);
             let e_star = mat.youngs_modulus / (1.0 - mat.poisson_ratio * mat.poisson_ratio);
             hertz_rows(&mut rows, shape, if name == "Al" { 1.0 } else { 2.0 }, &imp, shape.mass(r, mat.density), r, e_star, 0.2);
             assert_hertz(&imp, shape.mass(r, mat.density), r, e_star, 0.2, &format!("{name} {shape:?}"));
@@ -188,7 +187,7 @@ fn test_3_the_realised_restitution_is_the_input_one() {
         for (shape, _) in shapes() {
             for e in [0.1, 0.3, 0.5, 0.7, 0.9, 1.0] {
                 let s = on_plane(Material { restitution: e, ..mat.clone() }, shape, 2.5e-3, 3.9, 0.0, 0.0, 1000.0, TangentialSpec::Frictionless, false);
-                let (imp, _) = run(&s);
+                let imp = run(&s);
                 rows.add(shape, if mat.youngs_modulus > 2e11 { "Al2O3" } else { "cast_iron" }, e, "restitution_normal", imp.restitution_normal, Some(e));
                 assert!((imp.restitution_normal - e).abs() < 0.3 / 1000.0, "E = {} {shape:?} e = {e}: realised {}", mat.youngs_modulus, imp.restitution_normal);
             }
@@ -235,7 +234,7 @@ fn test_4_oblique_impacts_at_constant_speed() {
             for a in (1..=17).map(|k| 5.0 * k as f64) {
                 let t = a.to_radians();
                 let s = on_plane(mat.clone(), shape, 2.5e-3, 3.9 * t.cos(), 3.9 * t.sin(), 0.0, 500.0, form, true);
-                let (imp, _) = run(&s);
+                let imp = run(&s);
                 let what = format!("{form:?} {shape:?} {a} deg");
                 let e = imp.restitution_normal;
                 let sliding = t.tan() >= (1.0 + kappa) * 0.092 * (1.0 + e);
@@ -273,7 +272,7 @@ fn test_5_constant_normal_and_varying_tangential_velocity() {
                     continue;
                 }
                 let s = on_plane(mat.clone(), shape, 1e-5, 5.0, 5.0 * t.tan(), 0.0, 500.0, form, false);
-                let (imp, _) = run(&s);
+                let imp = run(&s);
                 assert_gross_sliding(&s, &imp, kappa, 0.3, &format!("{form:?} {shape:?} {a} deg"));
             }
         }
@@ -293,7 +292,7 @@ fn test_6_varying_initial_spin() {
         for (shape, kappa) in shapes() {
             for ratio in [-10.0, -4.0, 3.0, 5.0, 10.0] {
                 let s = on_plane(mat.clone(), shape, 0.1, 0.2, 0.0, ratio * 0.2 / 0.1, 500.0, form, true);
-                let (imp, _) = run(&s);
+                let imp = run(&s);
                 let e = imp.restitution_normal;
                 rows.add(shape, form_name(form), ratio, "vt_over_vn", imp.rebound_tangential_velocity_m_s / 0.2, Some(-ratio.signum() * 0.4 * (1.0 + e)));
                 rows.add(shape, form_name(form), ratio, "spin_r_over_vn", imp.rebound_spin_rad_s * 0.1 / 0.2, Some(ratio - ratio.signum() * kappa * 0.4 * (1.0 + e)));
@@ -313,7 +312,7 @@ fn test_6_varying_initial_spin() {
                 // Undamped (e = 1), the contact slides from the first step and the
                 // identities hold to rounding.
                 let s = on_plane(Material { restitution: 1.0, ..mat.clone() }, shape, 0.1, 0.2, 0.0, ratio * 0.2 / 0.1, 500.0, form, true);
-                let (imp, _) = run(&s);
+                let imp = run(&s);
                 if f64::abs(ratio) >= (1.0 + kappa) * 0.4 * 2.0 * 1.1 {
                     assert_gross_sliding(&s, &imp, kappa, 0.4, &format!("{what}, e = 1"));
                 }
@@ -332,7 +331,7 @@ fn test_7_two_equal_spheres_with_opposite_spins_feel_no_tangential_force() {
         for (shape, _) in shapes() {
             let mut s = pair((0.1, mat.clone()), (0.1, mat.clone()), shape, 0.4, 0.0, [3.0, -3.0], 500.0, true);
             s.model.tangential = form;
-            let (imp, _) = run(&s);
+            let imp = run(&s);
             assert_eq!(imp.rebound_spin_rad_s, 3.0, "{form:?} {shape:?}");
             assert_eq!(imp.rebound_tangential_velocity_m_s, 0.0, "{form:?} {shape:?}");
         }
@@ -352,7 +351,7 @@ fn test_8_a_small_sphere_on_a_larger_denser_one() {
             for w in [-40.0, 40.0] {
                 let mut s = pair((0.05, small.clone()), (0.1, large.clone()), shape, 0.2, 0.0, [w, 0.0], 500.0, true);
                 s.model.tangential = form;
-                let (imp, _) = run(&s);
+                let imp = run(&s);
                 // Head-on along x: n points from grain 1 to grain 0 (-x), t = (n.y, -n.x)
                 // = (0, 1); grain 0 approaches at v0 . n = -v0x. The summary projects the
                 // rebound on the line of centres at separation, which the tangential
@@ -375,7 +374,7 @@ fn test_8_a_small_sphere_on_a_larger_denser_one() {
                 let e1 = |m: &Material| Material { restitution: 1.0, ..m.clone() };
                 let mut s = pair((0.05, e1(&small)), (0.1, e1(&large)), shape, 0.2, 0.0, [w, 0.0], 500.0, true);
                 s.model.tangential = form;
-                let (imp, _) = run(&s);
+                let imp = run(&s);
                 let dvn = imp.rebound_normal_velocity_m_s + v0[0];
                 let dvt = imp.rebound_tangential_velocity_m_s;
                 assert!(rel(dvt, -slip * 0.4 * dvn) < 1e-3, "{what}, e = 1: dvt {dvt} vs -mu dvn {}", -slip * 0.4 * dvn);

@@ -224,7 +224,6 @@ impl EnergyMemory<crate::physics::lanes::Lanes> {
 
 /// A contact law: the trait the stages are generic over.
 pub trait ContactLaw: Copy + Send + Sync + 'static {
-    type Norm: Normal;
     type Damp: Damping;
     type Tang: Tangential;
     fn options(&self) -> ModelOptions;
@@ -369,7 +368,6 @@ impl<N: Normal, Dm: Damping, T: Tangential> ContactModel<N, Dm, T> {
 }
 
 impl<N: Normal, Dm: Damping, T: Tangential> ContactLaw for ContactModel<N, Dm, T> {
-    type Norm = N;
     type Damp = Dm;
     type Tang = T;
     fn options(&self) -> ModelOptions {

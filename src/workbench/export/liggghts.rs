@@ -60,16 +60,9 @@ pub(crate) fn deck(scene: &Scene, ex: &Exported) -> Result<String, Error> {
     let list = |g: &dyn Fn(&crate::physics::material::Material) -> f64| mats.iter().map(|m| f(g(m))).collect::<Vec<_>>().join(" ");
     let _ = writeln!(w, "fix m1 all property/global youngsModulus peratomtype {}", list(&|m| m.youngs_modulus));
     let _ = writeln!(w, "fix m2 all property/global poissonsRatio peratomtype {}", list(&|m| m.poisson_ratio));
-    let pair = |g: &dyn Fn(&PairMaterial) -> f64| {
-        let mut v = Vec::new();
-        for a in mats {
-            for b in mats {
-                let pm = PairMaterial::mix(a, b);
-                v.push(f(g(&pm)));
-            }
-        }
-        v.join(" ")
-    };
+    // A `peratomtypepair` table: g of each pair of atom types (materials), row by row.
+    let table = |g: &dyn Fn(usize, usize) -> f64| (0..n).flat_map(|a| (0..n).map(move |b| (a, b))).map(|(a, b)| f(g(a, b))).collect::<Vec<_>>().join(" ");
+    let pair = |g: &dyn Fn(&PairMaterial) -> f64| table(&|a, b| g(&PairMaterial::mix(&mats[a], &mats[b])));
     let _ = writeln!(w, "fix m3 all property/global coefficientRestitution peratomtypepair {n} {}", pair(&|pm| pm.restitution));
     let frictionless = model.tangential == TangentialSpec::Frictionless;
     let _ = writeln!(w, "fix m4 all property/global coefficientFriction peratomtypepair {n} {}", pair(&|pm| if frictionless { 0.0 } else { pm.friction }));
@@ -81,7 +74,6 @@ pub(crate) fn deck(scene: &Scene, ex: &Exported) -> Result<String, Error> {
         }
         NormalLaw::HookeStiffness { kn, kt } => {
             let rate = spring_rates(scene, p, e.walls(), kn, kt)?;
-            let table = |g: &dyn Fn(usize, usize) -> f64| (0..n).flat_map(|a| (0..n).map(move |b| (a, b))).map(|(a, b)| f(g(a, b))).collect::<Vec<_>>().join(" ");
             let _ = writeln!(w, "fix m5 all property/global kn peratomtypepair {n} {}", table(&|_, _| kn));
             let _ = writeln!(w, "fix m6 all property/global kt peratomtypepair {n} {}", table(&|_, _| kt));
             let _ = writeln!(w, "# gamman, gammat: LIGGGHTS damps with m* x these (1/s); grainlab's -2 beta(e) sqrt(k m*) is m* x -2 beta sqrt(k / m*), one m* per pair of atom types.");
