@@ -17,7 +17,7 @@ use grainlab::study::run::{RunOptions, RunReport, run_report, run_scene};
 use grainlab::scene::builtin::BUILTIN;
 
 #[derive(Parser)]
-#[command(name = "grainlab", version, about = "A 2D Hertz-Mindlin DEM engine, checked against LIGGGHTS and YADE", after_help = EXIT_CODES)]
+#[command(name = "grainlab", version, about = "A 2D Hertz-Mindlin DEM engine, checked against LIGGGHTS, YADE and LAMMPS", after_help = EXIT_CODES)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -80,7 +80,7 @@ enum Command {
     },
     /// Print the step pipeline of a scene in one line, with dt and steps per contact.
     Explain { scene: String },
-    /// Write an equivalent LIGGGHTS deck or YADE script, the shared particle file and
+    /// Write an equivalent LIGGGHTS deck, YADE script or LAMMPS deck, the shared particle file and
     /// export.json into a directory.
     Export {
         code: grainlab::workbench::export::Code,

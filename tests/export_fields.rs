@@ -27,7 +27,7 @@ use grainlab::workbench::export::fields::{self, FIELDS};
 use grainlab::workbench::export::{Code, export_files};
 use serde_json::{Value, json};
 
-const CODES: [Code; 2] = [Code::Liggghts, Code::Yade];
+const CODES: [Code; 3] = [Code::Liggghts, Code::Yade, Code::Lammps];
 
 /// What the values of a leaf are.
 #[derive(Clone, Debug, PartialEq)]
@@ -462,6 +462,10 @@ fn bases(dir: &Path) -> Vec<Base> {
     let mut s = shear.clone();
     s.model.normal = NormalLaw::HookeStiffness { kn: 2e5, kt: 1e5 };
     out.push(variant("shear-spring", &s, "shear", "model.normal", &["model.normal"]));
+    // The derived spring in the packing: LAMMPS takes one kn per pair of types, refused.
+    let mut s = shear.clone();
+    s.model.normal = NormalLaw::Hooke { characteristic_velocity: 1.0 };
+    out.push(variant("shear-hooke", &s, "shear", "model.normal", &["model.normal"]));
     let mut s = collision.clone();
     s.model.general_damping = Some(0.1);
     out.push(variant("collision-damped", &s, "collision", "model.general_damping", &["model.general_damping"]));
@@ -544,8 +548,8 @@ enum Outcome {
 /// What one change did: to the engine's run, and to each code's export.
 struct Probe {
     ran_differently: bool,
-    outcomes: [Outcome; 2],
-    notes: [Vec<String>; 2],
+    outcomes: [Outcome; 3],
+    notes: [Vec<String>; 3],
 }
 
 impl Probe {
@@ -554,10 +558,10 @@ impl Probe {
     }
 }
 
-fn probe(before_run: &[f64], before: &[Export; 2], after: &Scene) -> Probe {
+fn probe(before_run: &[f64], before: &[Export; 3], after: &Scene) -> Probe {
     let ran_differently = !same_run(before_run, &engine_run(after));
-    let mut notes: [Vec<String>; 2] = Default::default();
-    let outcomes = [0, 1].map(|c| {
+    let mut notes: [Vec<String>; 3] = Default::default();
+    let outcomes = [0, 1, 2].map(|c| {
         let now = export(after, CODES[c]);
         if let Ok(files) = &now {
             notes[c] = noted(files);
@@ -583,7 +587,7 @@ struct Tally {
 #[derive(Default)]
 struct Walk {
     tally: BTreeMap<(String, usize), Tally>,
-    notes: [BTreeSet<String>; 2],
+    notes: [BTreeSet<String>; 3],
     failures: Vec<String>,
     changes: usize,
 }
@@ -629,7 +633,7 @@ fn the_exporter_keeps_every_decision() {
     for b in &bases {
         let scene = Scene::from_json(&b.scene.to_string()).unwrap_or_else(|e| panic!("base {}: {e}", b.name));
         let run = engine_run(&scene);
-        let exports = [export(&scene, Code::Liggghts), export(&scene, Code::Yade)];
+        let exports = CODES.map(|c| export(&scene, c));
         for (c, e) in exports.iter().enumerate() {
             if let Ok(files) = e {
                 walk.notes[c].extend(noted(files));
@@ -641,7 +645,7 @@ fn the_exporter_keeps_every_decision() {
         // A variant is a change of one leaf of its parent.
         if let Some((of, leaf)) = b.variant_of {
             let parent = Scene::from_json(&by_name[of].scene.to_string()).unwrap();
-            let parent_exports = [export(&parent, Code::Liggghts), export(&parent, Code::Yade)];
+            let parent_exports = CODES.map(|c| export(&parent, c));
             let p = probe(&engine_run(&parent), &parent_exports, &scene);
             walk.record(&format!("{of} -> {}", b.name), leaf, p);
         }

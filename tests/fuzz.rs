@@ -367,7 +367,7 @@ fn exercise(text: &str, dir: &Path, export: bool, tally: &mut Tally, case: &str)
     }
     assert_files_finite(&out);
     if export {
-        for code in [grainlab::workbench::export::Code::Liggghts, grainlab::workbench::export::Code::Yade] {
+        for code in [grainlab::workbench::export::Code::Liggghts, grainlab::workbench::export::Code::Yade, grainlab::workbench::export::Code::Lammps] {
             match grainlab::workbench::export::export_files(&scene, code, false, &limits) {
                 Ok(files) => {
                     tally.exported += 1;

@@ -37,7 +37,8 @@ pub struct Row {
 impl Row {
     fn new(case: &str, code: Code, quantity: &str, engine: f64, reference: f64, tolerance: f64, relative: bool) -> Row {
         let abs_diff = (engine - reference).abs();
-        let rel_diff = abs_diff / reference.abs();
+        // Equal values differ by nothing, relatively too (both 0: a frictionless pair's spin).
+        let rel_diff = if abs_diff == 0.0 { 0.0 } else { abs_diff / reference.abs() };
         let d = if relative { rel_diff } else { abs_diff };
         Row { case: case.into(), code, quantity: quantity.into(), engine, reference, abs_diff, rel_diff: rel_diff.is_finite().then_some(rel_diff), tolerance, relative, pass: d <= tolerance }
     }

@@ -14,6 +14,7 @@ use crate::scene::Analysis;
 pub enum Code {
     Liggghts,
     Yade,
+    Lammps,
 }
 
 impl Code {
@@ -21,6 +22,7 @@ impl Code {
         match self {
             Code::Liggghts => "liggghts",
             Code::Yade => "yade",
+            Code::Lammps => "lammps",
         }
     }
     /// The deck's file name.
@@ -28,6 +30,7 @@ impl Code {
         match self {
             Code::Liggghts => "in.liggghts",
             Code::Yade => "yade.py",
+            Code::Lammps => "in.lammps",
         }
     }
 }

@@ -77,6 +77,7 @@ pub struct Field {
     pub path: &'static str,
     pub liggghts: Decision,
     pub yade: Decision,
+    pub lammps: Decision,
 }
 
 impl Field {
@@ -84,15 +85,23 @@ impl Field {
         match code {
             Code::Liggghts => &self.liggghts,
             Code::Yade => &self.yade,
+            Code::Lammps => &self.lammps,
         }
+    }
+    /// LAMMPS' decision where it is not LIGGGHTS' (the two read one input language, and
+    /// the LAMMPS deck shares the LIGGGHTS deck's commands for grains, rows and records).
+    const fn in_lammps(self, d: Decision) -> Field {
+        Field { lammps: d, ..self }
     }
 }
 
 const fn both(path: &'static str, d: Decision) -> Field {
-    Field { path, liggghts: d, yade: d }
+    Field { path, liggghts: d, yade: d, lammps: d }
 }
+/// LIGGGHTS' and YADE's decisions; LAMMPS takes LIGGGHTS' unless [`Field::in_lammps`]
+/// says otherwise.
 const fn each(path: &'static str, liggghts: Decision, yade: Decision) -> Field {
-    Field { path, liggghts, yade }
+    Field { path, liggghts, yade, lammps: liggghts }
 }
 
 const NAME_L: &str = "the comments of in.liggghts, the title line of grains.data, export.json `scene`; escaped to printable ASCII on one line (`\\`, quotes, control and non-ASCII characters as Rust escapes, `&` as `\\u{26}`): no line break starts a command and no comment ends in `&`, which would continue it onto the next line";
@@ -121,33 +130,43 @@ const LIST_X: &str = "grains.data Atoms: x y (z = 0)";
 const LIST_V: &str = "grains.data Velocities: vx vy";
 const LIST_R: &str = "grains.data Atoms: diameter 2 r";
 const ATOM_TYPE: &str = "grains.data atom type (material + 1)";
+const NAME_M: &str = "the comments of in.lammps, the title line of grains.data, export.json `scene`; escaped to printable ASCII on one line (`\\`, quotes, control and non-ASCII characters as Rust escapes, `&` as `\\u{26}`): no line break starts a command and no comment ends in `&`, which LAMMPS too reads as a line continued by the next";
+const Y_M: &str = "flat: `fix wall/gran granular ... yplane Y NULL` (bottom: grains above) or `yplane NULL Y` (top); rough: the row's atoms in grains.data";
+const SURFACE_M: &str = "flat: `fix wall/gran granular` planes (R* = r, m* = m, as grainlab), one per material of the free grains, each with that pair's coefficients; rough: a row of atoms in grains.data moved as one (setforce + nve)";
+const MATERIAL_M: &str = "flat: the wall/gran fixes take the coefficients of the pair (wall material, grain material); rough: the row's atom type in grains.data";
+const MODULI_M: &str = "each pair of atom types' `pair_coeff I J hertz KN ...` with KN = 4/3 E* and `tangential mindlin KT ...` with KT = 8 G*, mixed by grainlab (LAMMPS' hertz/material would take a given pair as one material, and mixes the pairs not given its own way); the derived spring's kn from E*";
+const SPRING_REFUSED_M: &str = "the derived spring where a pair of atom types, or a flat wall and a material of the free grains, meets at more than one kn (grains of several sizes or masses): LAMMPS' `hooke` takes one kn per pair of types and per wall fix";
+const SPRING_M: &str = "`hooke KN` and `tangential linear_history KT` in every pair_coeff and wall/gran fix; `damping tsuji` damps each contact with its own sqrt(m* kn), so grains of every size and mass are exact";
+const TANGENTIAL_M: &str = "LAMMPS' total-displacement history caps the total tangential force (elastic and damping) and, on slip, keeps the displacement that gives the cap with the damping; between grains it rescales the history to its length when the contact frame turns. grainlab's total_displacement caps the elastic force alone and projects the history: frictional contacts with damping (e < 1), and frictional grain pairs, differ (head-on and frictionless impacts, and a grain on a flat wall at e = 1, agree); incremental_force is YADE's law, which differs more";
 const NORMAL_Y: &str = "the linear spring (hooke, hooke_stiffness) is not exported to YADE yet: its linear laws (CundallStrack, ViscElPhys) take stiffness and damping in other terms, a mapping not yet checked against grainlab";
 const SPRING_L: &str = "`fix m5 kn`, `fix m6 kt` per pair of atom types, and the damping rates gamman, gammat = -2 beta(e) sqrt(k / m*) (LIGGGHTS multiplies them by m*)";
 const SPRING_REFUSED_L: &str = "a pair of materials that meets at more than one reduced mass (grains of two sizes, or a grain and a flat wall): hooke/stiffness takes one damping rate per pair of atom types, times m*";
-const SPIN_NO_ROTATION: &str = "a non-zero spin with model.rotation = false (and friction): grainlab's grain-grain contacts then leave the spin out of the contact velocity, LIGGGHTS (`nve`) and YADE (blocked rotation) keep the spin, which never changes, in it";
+const SPIN_NO_ROTATION: &str = "a non-zero spin with model.rotation = false (and friction): grainlab's grain-grain contacts then leave the spin out of the contact velocity, LIGGGHTS and LAMMPS (`nve`) and YADE (blocked rotation) keep the spin, which never changes, in it";
 const NOT_PHYSICS_OUTPUT: &str = "grainlab's own output";
 
 /// Every leaf of the scene schema and its decision for each code.
 pub const FIELDS: &[Field] = &[
-    each("name", written(NAME_L), written(NAME_Y)),
+    each("name", written(NAME_L), written(NAME_Y)).in_lammps(written(NAME_M)),
     both("description", outside("free text: no physics, not written (the decks name the scene by its name)")),
     each(
         "grain_shape",
         refused("\"disk\": not exported yet; the deck writes spheres at z = 0 (sphere_in_plane: mass 4/3 pi r^3 rho, inertia 2/5 m r^2), and LIGGGHTS' `dimension 2` disks (pi r^2 rho per metre, m r^2 / 2) would need a deck of their own (enforce2d, density times thickness), not written nor checked against LIGGGHTS"),
         refused("\"disk\": YADE's spheres with blockedDOFs 'zXY' are the sphere_in_plane model (mass 4/3 pi r^3 rho, inertia 2/5 m r^2); this contact law has no disk of a stated thickness there"),
-    ),
+    )
+    .in_lammps(refused("\"disk\": not exported yet; the deck writes spheres at z = 0 (sphere_in_plane: mass 4/3 pi r^3 rho, inertia 2/5 m r^2), and LAMMPS' disks (`dimension 2`, `set ... density/disc`, `fix enforce2d`) would need a deck of their own, not written nor checked against LAMMPS")),
     each(
         "grain_shape.disk.thickness",
         refused("disks are not exported yet (see grain_shape)"),
         refused("disks cannot be expressed (see grain_shape)"),
     ),
     both("materials[].name", outside("a label: the decks refer to materials by position (LIGGGHTS atom type k + 1, YADE mats[k])")),
-    each("materials[].youngs_modulus", written("`fix m1 ... youngsModulus peratomtype`"), written("E[k], FrictMat(young)")),
+    each("materials[].youngs_modulus", written("`fix m1 ... youngsModulus peratomtype`"), written("E[k], FrictMat(young)")).in_lammps(written(MODULI_M)),
     each(
         "materials[].poisson_ratio",
         written("`fix m2 ... poissonsRatio peratomtype` (LIGGGHTS mixes E* and G* as grainlab)"),
         written("NU[k], FrictMat(poisson) (YADE 2023.02 mixes E* and G* as grainlab)"),
-    ),
+    )
+    .in_lammps(written(MODULI_M)),
     each(
         "materials[].density",
         written("grains.data density column (atom mass 4/3 pi r^3 rho)"),
@@ -158,12 +177,14 @@ pub const FIELDS: &[Field] = &[
         written("`fix m3 ... coefficientRestitution peratomtypepair`, each pair the smaller e (grainlab's rule)"),
         written("BETA = sqrt(5/6) |beta(e)| as Ip2_FrictMat_FrictMat_MindlinPhys(betan = betas = BETA), never `en` (a different damping fit)")
             .or_refused("materials of different restitution: YADE's Ip2_FrictMat_FrictMat_MindlinPhys takes one betan for every pair"),
-    ),
+    )
+    .in_lammps(written("each pair of types' damping, the pair's smaller e: `damping tsuji` with the input c whose LAMMPS polynomial 1.2728 - 4.2783 c + 11.087 c^2 - 22.348 c^3 + 27.467 c^4 - 18.022 c^5 + 4.8218 c^6 equals sqrt(5) |beta(e)| (Hertz) or 2 |beta(e)| (linear spring), solved by bisection (c < 0 for e below about 0.11, c > 1 above 0.9995: LAMMPS does not clip it); `damping viscoelastic` with 0 at e = 1; the tangential damping x_gt = sqrt(kt / Sn), the tangential-to-normal ratio of grainlab's")),
     each(
         "materials[].friction",
         written("`fix m4 ... coefficientFriction peratomtypepair`, each pair the smaller mu (0 when frictionless)"),
         written("MU[k], FrictMat(frictionAngle = atan(mu)): YADE takes the pair's smaller angle (0 when frictionless)"),
-    ),
+    )
+    .in_lammps(written("each pair of types' `tangential ... MU`, the pair's smaller mu (0 when frictionless)")),
     each(
         "domain.periodic_x",
         written("`boundary p f f` and the box's x bounds in grains.data"),
@@ -195,27 +216,29 @@ pub const FIELDS: &[Field] = &[
     both("grains.pack.x", written(PACKED)),
     both("grains.pack.y_min", written(PACKED)),
     both("grains.pack.packing_fraction", written(PACKED)),
-    each("walls.bottom.y", written(Y_L), written(Y_Y)),
+    each("walls.bottom.y", written(Y_L), written(Y_Y)).in_lammps(written(Y_M)),
     each("walls.bottom.velocity_x", written(VX_L), written(VX_Y)),
     each("walls.bottom.velocity_y", written(VY_L).or_refused(VY_FLAT), written(VY_Y).or_refused(VY_FLAT)),
     each(
         "walls.bottom.surface",
         written(SURFACE_L).or_refused(FLAT_IN_SHEAR),
         written(SURFACE_Y).or_refused(FLAT_IN_SHEAR).or_differs("flat", FLAT_Y),
-    ),
+    )
+    .in_lammps(written(SURFACE_M).or_refused(FLAT_IN_SHEAR)),
     both("walls.bottom.surface.rough.radius", written(ROUGH_R)),
     both("walls.bottom.control", one_value(BOTTOM_CONTROL)),
     both("walls.bottom.control.pressure", one_value(BOTTOM_CONTROL)),
     both("walls.bottom.mass", outside(BOTTOM_MASS)),
-    each("walls.bottom.material", written(MATERIAL_L), written(MATERIAL_Y)),
-    each("walls.top.y", written(Y_L), written(Y_Y)),
+    each("walls.bottom.material", written(MATERIAL_L), written(MATERIAL_Y)).in_lammps(written(MATERIAL_M)),
+    each("walls.top.y", written(Y_L), written(Y_Y)).in_lammps(written(Y_M)),
     each("walls.top.velocity_x", written(VX_L), written(VX_Y)),
     each("walls.top.velocity_y", written(VY_L).or_refused(VY_FLAT), written(VY_Y).or_refused(VY_FLAT)),
     each(
         "walls.top.surface",
         written(SURFACE_L).or_refused(FLAT_IN_SHEAR),
         written(SURFACE_Y).or_refused(FLAT_IN_SHEAR).or_differs("flat", FLAT_Y),
-    ),
+    )
+    .in_lammps(written(SURFACE_M).or_refused(FLAT_IN_SHEAR)),
     both("walls.top.surface.rough.radius", written(ROUGH_R)),
     each(
         "walls.top.control",
@@ -229,13 +252,18 @@ pub const FIELDS: &[Field] = &[
         written("LOAD = p L_x t, a permanent force on the top row's clump (blockedDOFs 'xzXYZ')")
             .or_refused("on a flat wall (a wall body cannot carry a load; use a rough wall), or without a periodic x (the script moves a loaded row in the periodic cell only, and holds rough rows elsewhere)")
             .or_differs("any", "YADE's leapfrog takes the initial velocities as v(-1/2), grainlab's velocity Verlet as v(0): bodies under a force at t = 0 (the loaded wall, touching grains) start O(a dt^2) apart, which a flow forgets"),
+    )
+    .in_lammps(
+        written("the load p L_x t on the rough row: `setforce 0.0 NULL 0.0`, `aveforce NULL -F/n NULL` (per atom) and nve move it as one body of its atoms' mass")
+            .or_refused("on a flat wall: a wall/gran plane cannot carry a load; use a rough wall"),
     ),
     each(
         "walls.top.mass",
         refused("a loaded top wall whose mass differs from its row's atoms' total beyond rounding (1e-12): LIGGGHTS moves the row as its atoms (nve, aveforce), and another atom density would change the contact damping (m*); a fixed wall's mass has no effect, in grainlab either"),
         written("a loaded top row: the clump's state.mass (NewtonIntegrator accelerates a clump by F / state.mass; its spheres keep their own masses in the contact damping, as grainlab's glued grains); a fixed wall's mass has no effect, in grainlab either"),
-    ),
-    each("walls.top.material", written(MATERIAL_L), written(MATERIAL_Y)),
+    )
+    .in_lammps(refused("a loaded top wall whose mass differs from its row's atoms' total beyond rounding (1e-12): LAMMPS moves the row as its atoms (nve, aveforce), and another atom density would change the contact damping (m*); a fixed wall's mass has no effect, in grainlab either")),
+    each("walls.top.material", written(MATERIAL_L), written(MATERIAL_Y)).in_lammps(written(MATERIAL_M)),
     both("walls.thickness", written(THICKNESS)),
     each(
         "gravity",
@@ -247,39 +275,49 @@ pub const FIELDS: &[Field] = &[
         written("`pair_style gran model hertz` (hertz), `model hooke` (hooke), `model hooke/stiffness` (hooke_stiffness), in the pair style and the wall/gran fixes")
             .or_refused(SPRING_REFUSED_L),
         refused(NORMAL_Y),
-    ),
+    )
+    .in_lammps(written("`hertz` (hertz) or `hooke` (hooke, hooke_stiffness) in every pair_coeff and wall/gran fix").or_refused(SPRING_REFUSED_M)),
     each(
         "model.normal.hooke.characteristic_velocity",
         written("`fix m5 all property/global characteristicVelocity scalar VC` (LIGGGHTS derives kn = kt from it per contact, as grainlab does)"),
         refused(NORMAL_Y),
-    ),
+    )
+    .in_lammps(written("kn = kt of each pair of types and each wall fix, derived by grainlab from VC, E*, R* and m* (LIGGGHTS' formula): `hooke KN` and `tangential linear_history KT`").or_refused(SPRING_REFUSED_M)),
     each(
         "model.normal.hooke_stiffness.kn",
         written(SPRING_L).or_refused(SPRING_REFUSED_L),
         refused(NORMAL_Y),
-    ),
+    )
+    .in_lammps(written(SPRING_M)),
     each(
         "model.normal.hooke_stiffness.kt",
         written(SPRING_L).or_refused(SPRING_REFUSED_L),
         refused(NORMAL_Y),
-    ),
+    )
+    .in_lammps(written(SPRING_M)),
     each(
         "model.tangential",
         written("total_displacement: `pair_style gran model hertz tangential history`; frictionless: coefficientFriction 0 (Ft = 0) and `nve`")
             .or_differs("incremental_force", "LIGGGHTS has only the total-displacement history; head-on impacts agree, oblique ones differ (rebound spin up to 2x)"),
         written("incremental_force: Law2_ScGeom_MindlinPhys_Mindlin; frictionless: frictionAngle 0 (Ft = 0)")
             .or_differs("total_displacement", "YADE's Mindlin law adds force increments; head-on impacts agree, oblique ones differ (rebound spin up to 2x)"),
+    )
+    .in_lammps(
+        written("total_displacement: `tangential mindlin` (Hertz) or `tangential linear_history` (linear spring), a total tangential displacement; frictionless: MU 0 (Ft = 0) and `nve`")
+            .or_differs("total_displacement, incremental_force", TANGENTIAL_M),
     ),
     each(
         "model.limit_force",
         written("`limitForce on` in the pair style and the wall/gran fixes"),
         differs("false", "YADE always clamps Fn >= 0 (the realised restitution is higher, most for small e)"),
-    ),
+    )
+    .in_lammps(written("`limit_damping` in every pair_coeff and wall/gran fix: the total normal force clamped at 0, as grainlab's clamp")),
     each(
         "model.lever_arm",
         differs("radius, yade", "LIGGGHTS' arm is r - dn/2, in the torque and in the contact velocity (lever_arm radius_minus_half_overlap); torques and tangential velocities differ by O(dn/r)"),
         differs("radius, radius_minus_half_overlap", "YADE's ScGeom kinematics are lever_arm yade (full radii for the spins in the contact velocity, its translational part scaled by (r1 + r2) / (r1 + r2 - dn), torque arm r - dn/2, r - dn on a wall); torques and tangential velocities differ by O(dn/r)"),
-    ),
+    )
+    .in_lammps(differs("radius, radius_minus_half_overlap, yade", "LAMMPS' arms are r in the contact velocity and r - dn/2 in the torque between grains, r in both on a wall/gran plane: lever_arm radius for a grain on a flat wall, no grainlab variant for grain pairs; torques and tangential velocities of frictional grain pairs differ by O(dn/r)")),
     each(
         "model.rotation",
         written("false: `fix nve` for the free grains instead of `nve/sphere`"),
@@ -289,7 +327,8 @@ pub const FIELDS: &[Field] = &[
         "model.general_damping",
         refused("grainlab's drag is F = -c m v and M = -c I w on each free grain; LIGGGHTS' `fix viscous` applies -gamma v with one gamma per atom type and no torque"),
         refused("grainlab's drag is F = -c m v and M = -c I w on each free grain; NewtonIntegrator's damping is Cundall's non-viscous damping (the force scaled by 1 - d sign(F v)), LinearDragEngine a Stokes drag 6 pi nu r v without torque"),
-    ),
+    )
+    .in_lammps(refused("grainlab's drag is F = -c m v and M = -c I w on each free grain; LAMMPS' `fix viscous` applies -gamma v with one gamma per atom type and no torque")),
     each("time_step.rule.fixed.dt", written(RULE_L), written(RULE_Y)),
     each("time_step.rule.steps_per_contact.steps", written(RULE_L), written(RULE_Y)),
     each("time_step.rule.steps_per_contact.impact_speed", written(RULE_L), written(RULE_Y)),
@@ -331,7 +370,8 @@ pub const FIELDS: &[Field] = &[
         "stages[].duration",
         written("the stage's `run N` (N = ceil(duration / dt); `pre no` where only velocities change, so that LIGGGHTS keeps the last step's forces for the first half kick as grainlab does); export.json stages").or_refused(STAGES_FLAT),
         written("the stage's steps and first step in STAGES (its changes made at that step, one `O.run` for the protocol); export.json stages").or_refused(STAGES_OPEN),
-    ),
+    )
+    .in_lammps(written("the stage's `run N` (N = ceil(duration / dt); `pre no` where only velocities change, so that LAMMPS keeps the last step's forces for the first half kick as grainlab does); export.json stages").or_refused(STAGES_FLAT)),
     each(
         "stages[].walls.bottom.velocity_x",
         written("`velocity bottom set VX ...` on the row before the stage's run (the held row keeps it)"),
@@ -359,6 +399,10 @@ pub const FIELDS: &[Field] = &[
         written("\"fixed\": the row's `aveforce` removed and `setforce 0.0 0.0 0.0`, its y velocity set; a pressure: `setforce 0.0 NULL 0.0` and `aveforce`")
             .or_differs("a change of control after the first stage", "the fixes are replaced, so the stage's run needs LIGGGHTS' setup, which recomputes the forces at the step-end velocities (the stage's new wall velocities included) and rebuilds the neighbour list: the stage's first half kick differs from grainlab's (which uses the last step's forces), an O(dt) difference of one step"),
         written("\"fixed\": the clump blocked in y (`xyzXYZ`) at its velocity, no load; a pressure: free in y (`xzXYZ`) under setPermF"),
+    )
+    .in_lammps(
+        written("\"fixed\": the row's `aveforce` removed and `setforce 0.0 0.0 0.0`, its y velocity set; a pressure: `setforce 0.0 NULL 0.0` and `aveforce`")
+            .or_differs("a change of control after the first stage", "the fixes are replaced, so the stage's run needs LAMMPS' setup, which recomputes the forces at the step-end velocities (the stage's new wall velocities included) and rebuilds the neighbour list: the stage's first half kick differs from grainlab's (which uses the last step's forces), an O(dt) difference of one step"),
     ),
     each(
         "stages[].walls.top.control.pressure",
@@ -464,7 +508,7 @@ mod tests {
     fn paths_are_unique_and_every_decision_says_something() {
         for (k, f) in FIELDS.iter().enumerate() {
             assert!(FIELDS[..k].iter().all(|g| g.path != f.path), "{} twice", f.path);
-            for code in [Code::Liggghts, Code::Yade] {
+            for code in [Code::Liggghts, Code::Yade, Code::Lammps] {
                 let d = f.decision(code);
                 // A field is written, refused, outside or of one value; a Differs note
                 // alone is a decision too (the code does it its own way).

@@ -1,4 +1,7 @@
-//! The LIGGGHTS 3.8 input deck of a scene.
+//! The LIGGGHTS 3.8 input deck of a scene, and the LAMMPS deck, which reads the same
+//! input language: the LAMMPS deck is this one with its own contact model and flat walls
+//! ([`super::lammps`]), `atom_style sphere`, `comm_modify vel yes` and the spin read
+//! through a compute.
 //!
 //! Model: `pair_style gran model hertz tangential history`, with `limitForce on` when
 //! the scene clamps Fn >= 0; flat walls are primitive `wall/gran` planes (R* = r,
@@ -24,39 +27,151 @@ use crate::engine::world::WallMotion;
 use crate::physics::walls::{Control, Surface};
 use crate::scene::{Analysis, NormalLaw, Scene, TangentialSpec};
 
-pub(crate) fn deck(scene: &Scene, ex: &Exported) -> Result<String, Error> {
+/// The deck of `code`, [`Code::Liggghts`] or [`Code::Lammps`].
+pub(crate) fn deck(scene: &Scene, ex: &Exported, code: Code) -> Result<String, Error> {
+    let lammps = code == Code::Lammps;
     let model = &scene.model;
     let e = ex.built.engine.as_ref();
     let p = e.particles();
     let info = &ex.info;
     let mats = &scene.materials;
-    let n = mats.len();
     let mut s = String::new();
     let w = &mut s;
-    let _ = writeln!(w, "# LIGGGHTS 3.8.0 deck exported by grainlab {} from scene `{}`. Generated: do not edit;", env!("CARGO_PKG_VERSION"), comment(&scene.name));
-    let _ = writeln!(w, "# regenerate with `grainlab export liggghts SCENE --out DIR`.");
+    let version = if lammps { "LAMMPS 20220106 (29 Sep 2021, update 2)" } else { "LIGGGHTS 3.8.0" };
+    let _ = writeln!(w, "# {version} deck exported by grainlab {} from scene `{}`. Generated: do not edit;", env!("CARGO_PKG_VERSION"), comment(&scene.name));
+    let _ = writeln!(w, "# regenerate with `grainlab export {} SCENE --out DIR`.", code.name());
     let writes = match info.analysis {
         Analysis::Impact => "writes series.txt",
         Analysis::Shear => "writes walls.txt",
         Analysis::None => "records nothing",
     };
-    let _ = writeln!(w, "# Run in this directory: liggghts -in in.liggghts (reads grains.data, {writes}).");
+    if lammps {
+        let _ = writeln!(w, "# Run in this directory: lmp -in in.lammps, or on N processes mpirun -np N lmp -in in.lammps (reads grains.data, {writes}).");
+    } else {
+        let _ = writeln!(w, "# Run in this directory: liggghts -in in.liggghts (reads grains.data, {writes}).");
+    }
     let _ = writeln!(w, "# Grains: spheres at z = 0 in a 3D box (the sphere-in-plane model); nothing moves them out of the plane.");
-    if model.lever_arm != LeverArm::RadiusMinusHalfOverlap && model.tangential != TangentialSpec::Frictionless {
-        let _ = writeln!(w, "{}", differs_line(Code::Liggghts, "model.lever_arm", name_of(&model.lever_arm)));
+    let frictional = model.tangential != TangentialSpec::Frictionless;
+    if lammps {
+        // LAMMPS' arms and history agree with grainlab's radius and total displacement
+        // only for one grain on flat walls, and its history only without damping.
+        let pairs = p.len() > 1;
+        if frictional && (pairs || model.lever_arm != LeverArm::Radius) {
+            let _ = writeln!(w, "{}", differs_line(code, "model.lever_arm", name_of(&model.lever_arm)));
+        }
+        let damped = mats.iter().any(|m| m.restitution < 1.0);
+        if model.tangential == TangentialSpec::IncrementalForce || (frictional && (pairs || damped)) {
+            let _ = writeln!(w, "{}", differs_line(code, "model.tangential", name_of(&model.tangential)));
+        }
+    } else {
+        if model.lever_arm != LeverArm::RadiusMinusHalfOverlap && frictional {
+            let _ = writeln!(w, "{}", differs_line(code, "model.lever_arm", name_of(&model.lever_arm)));
+        }
+        if model.tangential == TangentialSpec::IncrementalForce {
+            let _ = writeln!(w, "{}", differs_line(code, "model.tangential", name_of(&model.tangential)));
+        }
     }
-    if model.tangential == TangentialSpec::IncrementalForce {
-        let _ = writeln!(w, "{}", differs_line(Code::Liggghts, "model.tangential", name_of(&model.tangential)));
+    if !frictional {
+        let _ = writeln!(w, "{}", if lammps { "# Frictionless: friction coefficient 0, so Ft = 0." } else { "# Frictionless: tangential history with coefficientFriction 0, so Ft = 0." });
     }
-    if model.tangential == TangentialSpec::Frictionless {
-        let _ = writeln!(w, "# Frictionless: tangential history with coefficientFriction 0, so Ft = 0.");
-    }
-    let _ = writeln!(w, "atom_style granular\natom_modify map array");
+    let _ = writeln!(w, "{}\natom_modify map array", if lammps { "atom_style sphere" } else { "atom_style granular" });
     let px = if e.boundary().is_periodic() { "p" } else { "f" };
-    let _ = writeln!(w, "boundary {px} f f\nnewton off\ncommunicate single vel yes\nunits si");
+    let comm = if lammps { "comm_modify vel yes" } else { "communicate single vel yes" };
+    let _ = writeln!(w, "boundary {px} f f\nnewton off\n{comm}\nunits si");
     let _ = writeln!(w, "read_data grains.data");
     let skin = scene.neighbor.skin * 2.0 * p.r[..p.n_free].iter().cloned().fold(f64::INFINITY, f64::min);
-    let _ = writeln!(w, "neighbor {} bin\nneigh_modify delay 0\nhard_particles yes", f(skin));
+    let _ = writeln!(w, "neighbor {} bin\nneigh_modify delay 0", f(skin));
+    let law = if lammps {
+        super::lammps::pair_style(w, scene, ex)?;
+        String::new()
+    } else {
+        let _ = writeln!(w, "hard_particles yes");
+        materials(w, scene, ex)?
+    };
+    let frictionless = !frictional;
+    let _ = writeln!(w, "timestep {}", f(info.time_step_s));
+    let _ = writeln!(w, "group free id <> 1 {}", p.n_free);
+    let _ = writeln!(w, "run 0");
+    let mut wall_vars: Vec<WallVars> = Vec::new();
+    for (index, wall) in e.walls().iter().enumerate() {
+        let name = wall.name;
+        match &wall.surface {
+            Surface::Flat => {
+                let shear = if wall.v.x != 0.0 { format!(" shear x {}", f(wall.v.x)) } else { String::new() };
+                if lammps {
+                    // The bottom wall holds the grains above it (LO), the top one below (HI).
+                    let plane = if wall.side > 0.0 { format!("yplane {} NULL{shear}", f(wall.y)) } else { format!("yplane NULL {}{shear}", f(wall.y)) };
+                    super::lammps::flat_wall(w, scene, ex, index, &plane)?;
+                } else {
+                    let _ = writeln!(w, "fix w_{name} free wall/gran {law} primitive type {} yplane {}{shear}", wall.material + 1 /* its material's atom type */, f(wall.y));
+                }
+            }
+            Surface::Rough { grains } => {
+                let (a, b) = (grains.start + 1, grains.end);
+                let _ = writeln!(w, "group {name} id <> {a} {b}");
+                match wall.control {
+                    Control::Fixed => {
+                        let _ = writeln!(w, "fix f_{name} {name} setforce 0.0 0.0 0.0");
+                    }
+                    Control::Load { force } => {
+                        let _ = writeln!(w, "fix f_{name} {name} setforce 0.0 NULL 0.0");
+                        load_row(w, code, wall, grains, p, force)?;
+                    }
+                }
+                // The grains' force on the row: what `setforce` found before it set the
+                // row's (defined before `aveforce`, it sees the contacts' sum alone), a fix
+                // every control keeps, so one recording serves a protocol's stages.
+                wall_vars.push((name, format!("f_f_{name}[1]"), format!("f_f_{name}[2]"), a));
+                let _ = writeln!(w, "fix i_{name} {name} nve");
+            }
+        }
+    }
+    let rotation = model.rotation && !frictionless;
+    let _ = writeln!(w, "fix integrate free {}", if rotation { "nve/sphere" } else { "nve" });
+    let _ = writeln!(w, "variable s equal step");
+    let record = if ex.bench { Analysis::None } else { info.analysis };
+    if !scene.stages.is_empty() {
+        // A protocol: one block per stage, the wall fixes changed between them.
+        let mut header = String::new();
+        stages(w, &mut header, scene, ex, code, record, &wall_vars)?;
+        // Its Differs lines go with the others, before the first command.
+        let at = s.find("atom_style").expect("the deck's first command");
+        s.insert_str(at, &header);
+        return Ok(s);
+    }
+    match record {
+        Analysis::Impact => {
+            // LAMMPS has no per-atom spin in variables: a compute reads it.
+            if lammps {
+                let _ = writeln!(w, "compute spin all property/atom omegaz");
+            }
+            let mut cols = vec!["${s}".to_string()];
+            for k in 1..=p.n_free {
+                for (q, v) in [("x", "x"), ("y", "y"), ("vx", "vx"), ("vy", "vy"), ("wz", if lammps { "c_spin" } else { "omegaz" }), ("fx", "fx"), ("fy", "fy")] {
+                    let _ = writeln!(w, "variable {q}{k} equal {v}[{k}]");
+                    cols.push(format!("${{{q}{k}}}"));
+                }
+            }
+            let _ = writeln!(w, "fix rec all print 1 \"{}\" file series.txt screen no title \"{}\"", cols.join(" "), info.columns.join(" "));
+        }
+        Analysis::Shear => record_walls(w, info.sample_every, &wall_vars, &info.columns),
+        Analysis::None => {
+            let _ = writeln!(w, "{}", if ex.bench { "# timing deck: nothing recorded" } else { "# analysis none: nothing recorded" });
+        }
+    }
+    let _ = writeln!(w, "thermo_style custom step atoms\nthermo {}", (info.steps / 10).max(1));
+    let _ = writeln!(w, "run {}", info.steps);
+    Ok(s)
+}
+
+/// LIGGGHTS' material fixes and pair style; returns the model words the pair style and
+/// the wall/gran fixes share (`model hertz tangential history ...`).
+fn materials(w: &mut String, scene: &Scene, ex: &Exported) -> Result<String, Error> {
+    let model = &scene.model;
+    let e = ex.built.engine.as_ref();
+    let p = e.particles();
+    let mats = &scene.materials;
+    let n = mats.len();
     let list = |g: &dyn Fn(&crate::physics::material::Material) -> f64| mats.iter().map(|m| f(g(m))).collect::<Vec<_>>().join(" ");
     let _ = writeln!(w, "fix m1 all property/global youngsModulus peratomtype {}", list(&|m| m.youngs_modulus));
     let _ = writeln!(w, "fix m2 all property/global poissonsRatio peratomtype {}", list(&|m| m.poisson_ratio));
@@ -84,69 +199,7 @@ pub(crate) fn deck(scene: &Scene, ex: &Exported) -> Result<String, Error> {
     };
     let law = format!("model {style} tangential history{}", if model.limit_force { " limitForce on" } else { "" });
     let _ = writeln!(w, "pair_style gran {law}\npair_coeff * *");
-    let _ = writeln!(w, "timestep {}", f(info.time_step_s));
-    let _ = writeln!(w, "group free id <> 1 {}", p.n_free);
-    let _ = writeln!(w, "run 0");
-    let mut wall_vars: Vec<WallVars> = Vec::new();
-    for wall in e.walls() {
-        let name = wall.name;
-        match &wall.surface {
-            Surface::Flat => {
-                let shear = if wall.v.x != 0.0 { format!(" shear x {}", f(wall.v.x)) } else { String::new() };
-                let _ = writeln!(w, "fix w_{name} free wall/gran {law} primitive type {} yplane {}{shear}", wall.material + 1 /* its material's atom type */, f(wall.y));
-            }
-            Surface::Rough { grains } => {
-                let (a, b) = (grains.start + 1, grains.end);
-                let _ = writeln!(w, "group {name} id <> {a} {b}");
-                match wall.control {
-                    Control::Fixed => {
-                        let _ = writeln!(w, "fix f_{name} {name} setforce 0.0 0.0 0.0");
-                    }
-                    Control::Load { force } => {
-                        let _ = writeln!(w, "fix f_{name} {name} setforce 0.0 NULL 0.0");
-                        load_row(w, wall, grains, p, force)?;
-                    }
-                }
-                // The grains' force on the row: what `setforce` found before it set the
-                // row's (defined before `aveforce`, it sees the contacts' sum alone), a fix
-                // every control keeps, so one recording serves a protocol's stages.
-                wall_vars.push((name, format!("f_f_{name}[1]"), format!("f_f_{name}[2]"), a));
-                let _ = writeln!(w, "fix i_{name} {name} nve");
-            }
-        }
-    }
-    let rotation = model.rotation && !frictionless;
-    let _ = writeln!(w, "fix integrate free {}", if rotation { "nve/sphere" } else { "nve" });
-    let _ = writeln!(w, "variable s equal step");
-    let record = if ex.bench { Analysis::None } else { info.analysis };
-    if !scene.stages.is_empty() {
-        // A protocol: one block per stage, the wall fixes changed between them.
-        let mut header = String::new();
-        stages(w, &mut header, scene, ex, record, &wall_vars)?;
-        // Its Differs lines go with the others, before the first command.
-        let at = s.find("atom_style").expect("the deck's first command");
-        s.insert_str(at, &header);
-        return Ok(s);
-    }
-    match record {
-        Analysis::Impact => {
-            let mut cols = vec!["${s}".to_string()];
-            for k in 1..=p.n_free {
-                for (q, v) in [("x", "x"), ("y", "y"), ("vx", "vx"), ("vy", "vy"), ("wz", "omegaz"), ("fx", "fx"), ("fy", "fy")] {
-                    let _ = writeln!(w, "variable {q}{k} equal {v}[{k}]");
-                    cols.push(format!("${{{q}{k}}}"));
-                }
-            }
-            let _ = writeln!(w, "fix rec all print 1 \"{}\" file series.txt screen no title \"{}\"", cols.join(" "), info.columns.join(" "));
-        }
-        Analysis::Shear => record_walls(w, info.sample_every, &wall_vars, &info.columns),
-        Analysis::None => {
-            let _ = writeln!(w, "{}", if ex.bench { "# timing deck: nothing recorded" } else { "# analysis none: nothing recorded" });
-        }
-    }
-    let _ = writeln!(w, "thermo_style custom step atoms\nthermo {}", (info.steps / 10).max(1));
-    let _ = writeln!(w, "run {}", info.steps);
-    Ok(s)
+    Ok(law)
 }
 
 /// The wall series' recording: the wall forces averaged over every `k` steps and the gap
@@ -185,7 +238,7 @@ type WallVars = (&'static str, String, String, usize);
 /// setup: that stage's first step then differs, and the deck says so (a `# Differs:` line
 /// at its top, `header`). What a flat wall would need (its motion and history live in its
 /// wall/gran fix) and gravity are refused by name.
-fn stages(w: &mut String, header: &mut String, scene: &Scene, ex: &Exported, record: Analysis, wall_vars: &[WallVars]) -> Result<(), Error> {
+fn stages(w: &mut String, header: &mut String, scene: &Scene, ex: &Exported, code: Code, record: Analysis, wall_vars: &[WallVars]) -> Result<(), Error> {
     let e = ex.built.engine.as_ref();
     let p = e.particles();
     let info = &ex.info;
@@ -214,7 +267,7 @@ fn stages(w: &mut String, header: &mut String, scene: &Scene, ex: &Exported, rec
                     } else {
                         let _ = writeln!(w, "unfix l_{name}");
                     }
-                    load_row(w, wall, grains, p, force)?;
+                    load_row(w, code, wall, grains, p, force)?;
                 }
                 (Control::Load { .. }, Some(Control::Fixed)) => {
                     let _ = writeln!(w, "unfix l_{name}\nunfix f_{name}\nfix f_{name} {name} setforce 0.0 0.0 0.0");
@@ -226,7 +279,7 @@ fn stages(w: &mut String, header: &mut String, scene: &Scene, ex: &Exported, rec
                     Some(Control::Load { force }) => format!("a load of {} N", f(force)),
                     _ => "\"fixed\"".into(),
                 };
-                let _ = writeln!(header, "{}", differs_line(Code::Liggghts, &format!("stages[{k}].walls.{name}.control"), value));
+                let _ = writeln!(header, "{}", differs_line(code, &format!("stages[{k}].walls.{name}.control"), value));
             }
             control[i] = change.control.unwrap_or(control[i]);
             // The y velocity as resolved for the stage (0 for a wall changed to fixed).
@@ -245,11 +298,11 @@ fn stages(w: &mut String, header: &mut String, scene: &Scene, ex: &Exported, rec
 /// The load `force` (N) on a rough `wall`'s row of `grains`: `aveforce` adds its share to
 /// each atom. The row moves as its atoms, so its mass must be theirs (equal atoms, so
 /// aveforce's equal forces keep it rigid): another is refused by name.
-fn load_row(w: &mut String, wall: &crate::physics::walls::Wall, grains: &std::ops::Range<usize>, p: &crate::physics::particles::Particles, force: f64) -> Result<(), Error> {
+fn load_row(w: &mut String, code: Code, wall: &crate::physics::walls::Wall, grains: &std::ops::Range<usize>, p: &crate::physics::particles::Particles, force: f64) -> Result<(), Error> {
     let name = wall.name;
     let atoms: f64 = grains.clone().map(|k| p.m[k]).sum();
     if (wall.mass - atoms).abs() > 1e-12 * atoms {
-        return Err(refuse(Code::Liggghts, &format!("walls.{name}.mass"), wall.mass, &format!("the row's {} atoms weigh {atoms:e} kg", grains.len())));
+        return Err(refuse(code, &format!("walls.{name}.mass"), wall.mass, &format!("the row's {} atoms weigh {atoms:e} kg", grains.len())));
     }
     let _ = writeln!(w, "# the load {} N on the row, per atom (aveforce adds its value to each atom)", f(force));
     let _ = writeln!(w, "fix l_{name} {name} aveforce NULL {} NULL", f(wall.side * force / grains.len() as f64));
@@ -282,18 +335,10 @@ pub(crate) fn name_of<T: serde::Serialize>(v: &T) -> String {
 /// is refused naming `model.normal.hooke_stiffness.kn` (and kt).
 fn spring_rates(scene: &Scene, p: &crate::physics::particles::Particles, walls: &[crate::physics::walls::Wall], kn: f64, kt: f64) -> Result<Vec<(f64, f64)>, Error> {
     let n = scene.materials.len();
-    // The masses of each material's free grains and glued grains (to 1e-12), with how
-    // many free grains have each.
-    let mut free: Vec<Vec<(f64, usize)>> = vec![Vec::new(); n];
-    let mut glued: Vec<Vec<(f64, usize)>> = vec![Vec::new(); n];
+    // The reduced masses each pair of types meets at: grain pairs, and grains on flat
+    // walls (m* = m), whose wall/gran fixes share the pair style's table.
+    let kinds = super::lammps::contact_kinds(n, p, walls);
     let same = |x: f64, m: f64| (x - m).abs() <= 1e-12 * m;
-    for k in 0..p.len() {
-        let list = if k < p.n_free { &mut free[p.material[k] as usize] } else { &mut glued[p.material[k] as usize] };
-        match list.iter_mut().find(|(x, _)| same(*x, p.m[k])) {
-            Some((_, c)) => *c += 1,
-            None => list.push((p.m[k], 1)),
-        }
-    }
     let mut stars: Vec<Vec<f64>> = vec![Vec::new(); n * n];
     let mut add = |a: usize, b: usize, m: f64| {
         for (x, y) in [(a, b), (b, a)] {
@@ -303,22 +348,16 @@ fn spring_rates(scene: &Scene, p: &crate::physics::particles::Particles, walls: 
         }
     };
     for a in 0..n {
-        for (ka, &(ma, ca)) in free[a].iter().enumerate() {
-            // Free grains of this and the later materials (a grain does not touch itself).
-            for (b, fb) in free.iter().enumerate().skip(a) {
-                for (kb, &(mb, _)) in fb.iter().enumerate() {
-                    if b > a || kb > ka || (kb == ka && ca > 1) {
-                        add(a, b, crate::physics::material::reduced(ma, mb));
-                    }
-                }
+        for b in 0..n {
+            for &(m, _) in &kinds.pairs[a * n + b] {
+                add(a, b, m);
             }
-            for (b, g) in glued.iter().enumerate() {
-                for &(mb, _) in g {
-                    add(a, b, crate::physics::material::reduced(ma, mb));
-                }
-            }
-            for wall in walls.iter().filter(|w| w.is_flat()) {
-                add(a, wall.material, ma);
+        }
+    }
+    for (wall, per) in walls.iter().zip(&kinds.walls) {
+        for (a, list) in per.iter().enumerate() {
+            for &(m, _) in list {
+                add(a, wall.material, m);
             }
         }
     }

@@ -1,15 +1,15 @@
-//! Exporting a scene to the reference codes: an equivalent LIGGGHTS 3.8 input deck and
-//! YADE 2023.02 script, never hand-kept twins.
+//! Exporting a scene to the reference codes: an equivalent LIGGGHTS 3.8 input deck, YADE
+//! 2023.02 script and LAMMPS 20220106 input deck, never hand-kept twins.
 //!
 //! The scene is built first, so both decks start from exactly the grains grainlab starts
 //! from (a packing is generated once, here). Files written to the output directory:
 //! - `grains.data`: the shared particle file, in the LAMMPS data format because that is
 //!   the one LIGGGHTS reads (`atom-ID type diameter density x y z`, then velocities and
 //!   spins); the YADE script parses the same file;
-//! - `in.liggghts` or `yade.py`: the deck;
+//! - `in.liggghts`, `yade.py` or `in.lammps`: the deck;
 //! - `export.json`: what the deck measures and how to read its output ([`ExportInfo`]).
 //!
-//! Both decks write the same raw output in the working directory: `series.txt` (impact
+//! Every deck writes the same raw output in the working directory: `series.txt` (impact
 //! scenes: the state of grains 1 and 2 at every step) or `walls.txt` (wall scenes: wall
 //! forces averaged over each sample interval). `scripts/regen-reference` turns that into
 //! the reference CSV schema.
@@ -24,6 +24,7 @@
 
 pub mod common;
 pub mod fields;
+pub mod lammps;
 pub mod liggghts;
 pub mod prepare;
 pub mod yade;
@@ -62,7 +63,7 @@ pub fn export_files(scene: &Scene, code: Code, bench: bool, limits: &crate::scen
     ex.bench = bench;
     let b = bounds(&ex.built, scene.duration);
     let deck = match code {
-        Code::Liggghts => liggghts::deck(scene, &ex)?,
+        Code::Liggghts | Code::Lammps => liggghts::deck(scene, &ex, code)?,
         Code::Yade => yade::deck(scene, &ex)?,
     };
     let data = grains_data(scene, &ex.built, [[b[0][0], b[1][0]], [b[0][1], b[1][1]], [b[0][2], b[1][2]]]);

@@ -1,0 +1,245 @@
+//! What the LAMMPS deck (version 20220106, Debian's `lmp`) says in its own words; the rest
+//! of it is the LIGGGHTS deck's ([`super::liggghts`]), the same input language: grains,
+//! rough rows, loads, stages and records.
+//!
+//! Model: `pair_style granular` with one `pair_coeff I J` for every pair of atom types
+//! (LAMMPS would mix a pair it is not given from the two types' own, not as grainlab
+//! mixes), each the pair's numbers as grainlab computes them:
+//! - Hertz: `hertz KN D tangential mindlin KT X MU`, KN = 4/3 E*, KT = 8 G* (LAMMPS
+//!   multiplies both by sqrt(R* dn)); the linear spring: `hooke KN D tangential
+//!   linear_history KT X MU`, the derived spring's kn = kt from its (R*, m*), one per pair
+//!   of types or refused by name;
+//! - damping: `damping tsuji` damps a contact with `alpha(D) sqrt(m* k)`, k the secant
+//!   normal stiffness (KN sqrt(R* dn) or KN), and alpha LAMMPS' polynomial of its input D
+//!   ([`tsuji_alpha`]); grainlab's gn is that with alpha = sqrt(5) |beta(e)| (Hertz:
+//!   2 sqrt(5/6) |beta| sqrt(Sn m*), Sn = 3/2 k) or 2 |beta(e)| (spring), so D is the root
+//!   of the polynomial ([`tsuji_input`]); the tangential damping is X times the normal one,
+//!   X = grainlab's gt / gn. At e = 1, `damping viscoelastic` with D = 0 (no damping: the
+//!   polynomial's value at 1 is 3e-4, not 0);
+//! - the clamp: `limit_damping` (the total normal force held at 0 or above);
+//! - flat walls: `fix wall/gran granular` with the same words (R* = r, m* = m), one fix per
+//!   material of the free grains, for the pair (wall material, grain material): a
+//!   wall/gran fix has one set of coefficients.
+//!
+//! What differs by design (the deck's `# Differs:` lines, [`super::fields`]): LAMMPS'
+//! tangential history caps the total tangential force, damping included, and rescales the
+//! history when a pair's contact frame turns; its lever arms are r in the contact velocity
+//! and r - dn/2 in a pair's torque (r on a wall).
+
+use std::fmt::Write as _;
+
+use super::common::{Code, f};
+use super::fields::refuse;
+use super::prepare::Exported;
+use crate::error::Error;
+use crate::physics::material::PairMaterial;
+use crate::physics::particles::Particles;
+use crate::physics::walls::Wall;
+use crate::scene::{NormalLaw, Scene, TangentialSpec};
+
+/// LAMMPS' `damping tsuji` coefficient of its input `c` (GRANULAR's pair_granular.cpp and
+/// fix_wall_gran.cpp, LAMMPS 29Sep2021): a fit of Tsuji et al. (1992), written as LAMMPS
+/// evaluates it.
+pub fn tsuji_alpha(c: f64) -> f64 {
+    1.2728 - 4.2783 * c + 11.087 * c.powi(2) - 22.348 * c.powi(3) + 27.467 * c.powi(4) - 18.022 * c.powi(5) + 4.8218 * c.powi(6)
+}
+
+/// The input c for which LAMMPS' Tsuji polynomial gives `alpha` (> 0). The polynomial
+/// falls monotonically on [-1, 1.1] from 89.1 to -0.05 (tested), so every alpha of a
+/// restitution in (0, 1) has one root there, found by bisection to the last bit. LAMMPS
+/// does not clip c to [0, 1]: e below about 0.11 needs c < 0, e above 0.9995 c > 1.
+pub fn tsuji_input(alpha: f64) -> f64 {
+    let (mut lo, mut hi) = (-1.0_f64, 1.1_f64);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if mid <= lo || mid >= hi {
+            break;
+        }
+        if tsuji_alpha(mid) > alpha {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    // The closer of the two bracketing inputs.
+    if (tsuji_alpha(lo) - alpha).abs() <= (tsuji_alpha(hi) - alpha).abs() { lo } else { hi }
+}
+
+/// The (m*, R*) of the contacts each pair of materials can make between grains, indexed
+/// `[a * n + b]` (both orders), and of each flat wall's contacts with the free grains of
+/// each material, `[wall][material]`: distinct values (to 1e-12), free grains with free
+/// grains (a material's grain with another of its own only if it has two), free grains
+/// with glued ones.
+pub(crate) struct ContactKinds {
+    pub pairs: Vec<Vec<(f64, f64)>>,
+    pub walls: Vec<Vec<Vec<(f64, f64)>>>,
+}
+
+pub(crate) fn contact_kinds(n: usize, p: &Particles, walls: &[Wall]) -> ContactKinds {
+    let same = |x: f64, m: f64| (x - m).abs() <= 1e-12 * m.abs();
+    let add = |list: &mut Vec<(f64, f64)>, k: (f64, f64)| {
+        if !list.iter().any(|&(m, r)| same(k.0, m) && same(k.1, r)) {
+            list.push(k);
+        }
+    };
+    // Each material's distinct (m, r) of free grains, with how many, and of glued grains.
+    let mut free: Vec<Vec<((f64, f64), usize)>> = vec![Vec::new(); n];
+    let mut glued: Vec<Vec<(f64, f64)>> = vec![Vec::new(); n];
+    for k in 0..p.len() {
+        let (m, r, mat) = (p.m[k], p.r[k], p.material[k] as usize);
+        if k < p.n_free {
+            match free[mat].iter_mut().find(|((x, y), _)| same(*x, m) && same(*y, r)) {
+                Some((_, c)) => *c += 1,
+                None => free[mat].push(((m, r), 1)),
+            }
+        } else {
+            add(&mut glued[mat], (m, r));
+        }
+    }
+    let reduced = crate::physics::material::reduced;
+    let mut pairs = vec![Vec::new(); n * n];
+    for a in 0..n {
+        for (ka, &((ma, ra), ca)) in free[a].iter().enumerate() {
+            for (b, fb) in free.iter().enumerate().skip(a) {
+                for (kb, &((mb, rb), _)) in fb.iter().enumerate() {
+                    if b > a || kb > ka || (kb == ka && ca > 1) {
+                        for (x, y) in [(a, b), (b, a)] {
+                            add(&mut pairs[x * n + y], (reduced(ma, mb), reduced(ra, rb)));
+                        }
+                    }
+                }
+            }
+            for (b, g) in glued.iter().enumerate() {
+                for &(mb, rb) in g {
+                    for (x, y) in [(a, b), (b, a)] {
+                        add(&mut pairs[x * n + y], (reduced(ma, mb), reduced(ra, rb)));
+                    }
+                }
+            }
+        }
+    }
+    let walls = walls
+        .iter()
+        .map(|w| {
+            let mut per = vec![Vec::new(); n];
+            if w.is_flat() {
+                for (a, fa) in free.iter().enumerate() {
+                    for &((m, r), _) in fa {
+                        add(&mut per[a], (m, r));
+                    }
+                }
+            }
+            per
+        })
+        .collect();
+    ContactKinds { pairs, walls }
+}
+
+/// The contact model words of a pair of materials `pm` whose contacts all have the
+/// (m*, R*) of `kinds` (the derived spring needs one kn among them; `what` names the pair
+/// in a refusal).
+fn words(scene: &Scene, pm: &PairMaterial, kinds: &[(f64, f64)], what: &str) -> Result<String, Error> {
+    let model = &scene.model;
+    let mu = if model.tangential == TangentialSpec::Frictionless { 0.0 } else { pm.friction };
+    // The normal words, the tangential stiffness and model, and the damping's alpha and
+    // tangential-to-normal ratio (grainlab's gt / gn).
+    let beta = pm.beta.abs();
+    let (normal, kt, tangential, alpha, ratio) = match model.normal {
+        NormalLaw::Hertz => {
+            let ratio = if pm.viscous_n != 0.0 { pm.viscous_t / pm.viscous_n } else { (4.0 * pm.g_star / pm.e_star).sqrt() };
+            (("hertz", 4.0 / 3.0 * pm.e_star), 8.0 * pm.g_star, "mindlin", 5f64.sqrt() * beta, ratio)
+        }
+        NormalLaw::HookeStiffness { kn, kt } => (("hooke", kn), kt, "linear_history", 2.0 * beta, (kt / kn).sqrt()),
+        NormalLaw::Hooke { characteristic_velocity } => {
+            // One kn for every contact of the pair (a pair that never meets takes the
+            // first value any would have: its coefficients are never used).
+            let stiff = |&(m, r): &(f64, f64)| model.normal.stiffness(pm, r, m, 0.0).kn;
+            let kns: Vec<f64> = kinds.iter().map(stiff).collect();
+            if let Some(k) = kns.iter().find(|k| (**k - kns[0]).abs() > 1e-12 * kns[0]) {
+                return Err(refuse(Code::Lammps, "model.normal.hooke.characteristic_velocity", characteristic_velocity, &format!("{what} meet at kn = {:e} N/m and {k:e} N/m", kns[0])));
+            }
+            let kn = kns.first().copied().unwrap_or(1.0);
+            (("hooke", kn), kn, "linear_history", 2.0 * beta, 1.0)
+        }
+    };
+    let (damping, d) = if beta == 0.0 { ("viscoelastic", 0.0) } else { ("tsuji", tsuji_input(alpha)) };
+    let limit = if model.limit_force { " limit_damping" } else { "" };
+    Ok(format!("{} {} {} tangential {tangential} {} {} {} damping {damping}{limit}", normal.0, f(normal.1), f(d), f(kt), f(ratio), f(mu)))
+}
+
+/// `pair_style granular` and a `pair_coeff` for every pair of atom types.
+pub(crate) fn pair_style(w: &mut String, scene: &Scene, ex: &Exported) -> Result<(), Error> {
+    let e = ex.built.engine.as_ref();
+    let mats = &scene.materials;
+    let n = mats.len();
+    let kinds = contact_kinds(n, e.particles(), e.walls());
+    let _ = writeln!(w, "# Each pair of atom types (materials) with grainlab's numbers: normal KN D, tangential KT X MU; D is the input of LAMMPS' Tsuji polynomial that gives grainlab's damping (docs/fidelity.md, LAMMPS).");
+    let _ = writeln!(w, "pair_style granular");
+    for a in 0..n {
+        for b in a..n {
+            let pm = PairMaterial::mix(&mats[a], &mats[b]);
+            let model = words(scene, &pm, &kinds.pairs[a * n + b], &format!("materials[{a}] and materials[{b}]"))?;
+            let _ = writeln!(w, "pair_coeff {} {} {model}", a + 1, b + 1);
+        }
+    }
+    Ok(())
+}
+
+/// A flat wall: one `fix wall/gran granular` per material of the free grains, on the free
+/// grains of that material, with the coefficients of the pair (wall material, grain
+/// material); `plane` is its `yplane LO HI` and `shear x V` words.
+pub(crate) fn flat_wall(w: &mut String, scene: &Scene, ex: &Exported, index: usize, plane: &str) -> Result<(), Error> {
+    let e = ex.built.engine.as_ref();
+    let (p, wall) = (e.particles(), &e.walls()[index]);
+    let mats = &scene.materials;
+    let kinds = contact_kinds(mats.len(), p, e.walls());
+    let present: Vec<usize> = (0..mats.len()).filter(|&a| !kinds.walls[index][a].is_empty()).collect();
+    for &a in &present {
+        let pm = PairMaterial::mix(&mats[wall.material], &mats[a]);
+        let model = words(scene, &pm, &kinds.walls[index][a], &format!("walls.{} and the free grains of materials[{a}]", wall.name))?;
+        let group = if present.len() == 1 {
+            "free".to_string()
+        } else {
+            let _ = writeln!(w, "group t{} type {}\ngroup free_t{} intersect free t{}", a + 1, a + 1, a + 1, a + 1);
+            format!("free_t{}", a + 1)
+        };
+        let _ = writeln!(w, "fix w_{}_{} {group} wall/gran granular {model} {plane}", wall.name, a + 1);
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_tsuji_polynomial_falls_over_the_bisection_interval() {
+        // Monotonic on [-1, 1.1]: one root for every alpha in between.
+        let mut last = f64::INFINITY;
+        for k in 0..=21000 {
+            let c = -1.0 + 2.1 * k as f64 / 21000.0;
+            let a = tsuji_alpha(c);
+            assert!(a < last, "not falling at {c}");
+            last = a;
+        }
+        assert!(tsuji_alpha(-1.0) > 80.0 && tsuji_alpha(1.1) < 0.0);
+    }
+
+    #[test]
+    fn the_remap_returns_grainlab_damping_to_rounding() {
+        // Every restitution of the workbench and the ends: LAMMPS' alpha of the input is
+        // sqrt(5) |beta(e)| (Hertz) and 2 |beta(e)| (spring) to 1e-14 absolute, the
+        // rounding of a sum of terms up to 30 (relative 1e-13 at e = 0.5, 1e-9 at
+        // e = 0.99999, where alpha is 7e-6).
+        for e in [1e-3, 0.05, 0.1, 0.114, 0.3, 0.5, 0.7, 0.9, 0.99, 0.9995, 0.99999] {
+            let beta = crate::physics::material::beta(e).abs();
+            for alpha in [5f64.sqrt() * beta, 2.0 * beta] {
+                let c = tsuji_input(alpha);
+                assert!((tsuji_alpha(c) - alpha).abs() <= 1e-14, "e = {e}: alpha {alpha}, c {c}, back {}", tsuji_alpha(c));
+            }
+        }
+        // The notes' example: e = 0.5 needs 0.36665136 (Hertz).
+        let c = tsuji_input(5f64.sqrt() * crate::physics::material::beta(0.5).abs());
+        assert!((c - 0.36665136).abs() < 1e-8, "{c}");
+    }
+}
