@@ -67,7 +67,7 @@ pub fn cases() -> Vec<Case> {
                     let name = format!("restitution/e{}-v{}-n{}-{}", num(e), num(v), num(n), if clamp { "clamp" } else { "free" });
                     s.name = name.replace('/', "-");
                     s.description = format!("head-on glass beads r = 1 mm, e = {e}, v = {v} m/s, dt = t_c/{n}, Fn clamp {}", if clamp { "on" } else { "off" });
-                    let codes = if clamp { vec![Code::Liggghts, Code::Yade] } else { vec![Code::Liggghts] };
+                    let codes = if clamp { vec![Code::Liggghts, Code::Yade, Code::Lammps] } else { vec![Code::Liggghts, Code::Lammps] };
                     let curve = n == 500.0 && v == 1.0 && [0.1, 0.5, 0.9].contains(&e);
                     out.push(Case { info: CaseInfo { name, description: s.description.clone(), codes, quick: v == 1.0, curve, ensemble: None }, scene: s });
                 }
@@ -85,6 +85,7 @@ pub fn cases() -> Vec<Case> {
             }
         }
     }
+    lammps_cases(&mut out);
     linear_spring_cases(&mut out);
     chung_ooi_cases(&mut out);
     let mut s = builtin::shear();
@@ -93,6 +94,11 @@ pub fn cases() -> Vec<Case> {
     s.description = "the shear cell (built-in `shear`) with LIGGGHTS' lever arm".into();
     s.output.frames = 0;
     out.push(Case { info: CaseInfo { name: "shear/liggghts".into(), description: s.description.clone(), codes: vec![Code::Liggghts], quick: false, curve: false, ensemble: None }, scene: s });
+    let mut s = builtin::shear();
+    s.name = "shear-lammps".into();
+    s.description = "the shear cell (built-in `shear`) as it is (lever arm r): LAMMPS' tangential history caps the total force and its arms differ by O(dn/r), a difference of model the time averages are checked to stay inside".into();
+    s.output.frames = 0;
+    out.push(Case { info: CaseInfo { name: "shear/lammps".into(), description: s.description.clone(), codes: vec![Code::Lammps], quick: false, curve: false, ensemble: None }, scene: s });
     let mut s = builtin::shear();
     matched(&mut s, TangentialSpec::IncrementalForce);
     s.name = "shear-yade".into();
@@ -138,6 +144,28 @@ pub fn cases() -> Vec<Case> {
 pub const SPRING_KN: f64 = 2.0e5;
 pub const SPRING_KT: f64 = 1.5e5;
 
+/// The impacts LAMMPS computes as grainlab does beyond head-on (where the restitution
+/// grid has it): a grain on a flat wall at e = 1 with friction (mu = 0.5) and the lever
+/// arm r, where LAMMPS' total-displacement history is grainlab's (no damping to cap, no
+/// frame to turn), and frictionless oblique pairs (e = 0.9), whose normal force turns with
+/// the line of centres. `oblique-wall/lammps-*` and `oblique-pair/lammps-frictionless-*`.
+fn lammps_cases(out: &mut Vec<Case>) {
+    for &a in &ANGLES {
+        let mut s = builtin::oblique(glass(1.0), 1e-3, 1.0, a, TangentialSpec::TotalDisplacement, 200.0);
+        s.model.lever_arm = LeverArm::Radius;
+        let name = format!("oblique-wall/lammps-a{}", num(a));
+        s.name = name.replace('/', "-");
+        s.description = format!("glass bead on a flat glass wall at 1 m/s, {a} deg from the normal, e = 1, mu = 0.5, lever arm r (LAMMPS' wall/gran), t_c/200");
+        out.push(Case { info: CaseInfo { name, description: s.description.clone(), codes: vec![Code::Lammps], quick: a == 45.0, curve: false, ensemble: None }, scene: s });
+        let mut s = builtin::oblique_pair(glass(0.9), 1e-3, 1.0, a, TangentialSpec::Frictionless, 200.0);
+        s.model.lever_arm = LeverArm::Radius;
+        let name = format!("oblique-pair/lammps-frictionless-a{}", num(a));
+        s.name = name.replace('/', "-");
+        s.description = format!("glass bead on a resting one at 1 m/s, {a} deg from the line of centres, e = 0.9, frictionless, t_c/200");
+        out.push(Case { info: CaseInfo { name, description: s.description.clone(), codes: vec![Code::Lammps], quick: a == 45.0, curve: false, ensemble: None }, scene: s });
+    }
+}
+
 /// The linear spring against LIGGGHTS (`model hooke` and `hooke/stiffness`, tangential
 /// history, its lever arm): a head-on restitution grid for both forms (e = 0.1, 0.5, 0.9;
 /// t_c/50 and t_c/500; with and without the clamp), oblique impacts on a flat wall
@@ -157,7 +185,7 @@ fn linear_spring_cases(out: &mut Vec<Case>) {
                     s.name = name.replace('/', "-");
                     s.description = format!("head-on glass beads r = 1 mm on the linear spring ({tag} stiffness), e = {e}, v = 1 m/s, dt = t_c/{n}, Fn clamp {}", if clamp { "on" } else { "off" });
                     let curve = n == 500.0 && e == 0.5 && !clamp;
-                    out.push(Case { info: CaseInfo { name, description: s.description.clone(), codes: vec![Code::Liggghts], quick: true, curve, ensemble: None }, scene: s });
+                    out.push(Case { info: CaseInfo { name, description: s.description.clone(), codes: vec![Code::Liggghts, Code::Lammps], quick: true, curve, ensemble: None }, scene: s });
                 }
             }
         }
