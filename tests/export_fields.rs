@@ -453,6 +453,10 @@ fn bases(dir: &Path) -> Vec<Base> {
     let mut hertz = json_of(&collision);
     hertz["model"]["normal"] = json!("hertz");
     out.push(Base { name: "collision-hertz", scene: hertz, only: &["model.normal"], variant_of: None });
+    // The default damping, written out: the walk moves it to LAMMPS' Tsuji fit.
+    let mut damped = json_of(&collision);
+    damped["model"]["damping"] = json!("restitution");
+    out.push(Base { name: "collision-damping", scene: damped, only: &["model.damping"], variant_of: None });
     let mut s = collision.clone();
     s.model.normal = NormalLaw::Hooke { characteristic_velocity: 1.0 };
     out.push(variant("collision-hooke", &s, "collision", "model.normal", &["model.normal"]));

@@ -129,6 +129,10 @@ fn bases(dir: &Path) -> Vec<Value> {
     spring_pair["model"]["normal"] = json!({"hooke_stiffness": {"kn": 2e5, "kt": 1.5e5}});
     spring_pair["time_step"]["rule"] = json!({"seed_rule": {"factor": 0.1, "reference_overlap": 0.01}});
     out.push(spring_pair);
+    // LAMMPS' Tsuji damping in the loaded shear cell.
+    let mut tsuji = json(&shear);
+    tsuji["model"]["damping"] = "tsuji".into();
+    out.push(tsuji);
     out
 }
 

@@ -145,7 +145,7 @@ proptest! {
     fn four_lanes_give_each_contact_its_own_bits(c0 in contact(), c1 in contact(), c2 in contact(), c3 in contact(), clamp in any::<bool>(), lever in 0usize..3) {
         use grainlab::physics::contact::LeverArm;
         use grainlab::physics::contact::tangential::{IncrementalForce, IncrementalState, TotalDisplacement};
-        use grainlab::physics::contact::damping::{LinearRestitution, Viscoelastic};
+        use grainlab::physics::contact::damping::{LinearRestitution, TsujiFit, Viscoelastic};
         use grainlab::physics::contact::normal::{Hertz, Hooke};
         let lever = [LeverArm::Radius, LeverArm::RadiusMinusHalfOverlap, LeverArm::Yade][lever];
         let cs = [c0, c1, c2, c3];
@@ -158,6 +158,9 @@ proptest! {
         for spring in [Hooke::Derived { vc: 0.8 }, Hooke::Given { kn: 3e5, kt: 2e5 }] {
             lanes_match_alone::<Hooke, LinearRestitution, TotalDisplacement>(spring, &cs, clamp, lever, |c| Vec2::new(c[5], c[6]), v)?;
             lanes_match_alone::<Hooke, LinearRestitution, IncrementalForce>(spring, &cs, clamp, lever, incremental, incremental_bits)?;
+            lanes_match_alone::<Hooke, TsujiFit, TotalDisplacement>(spring, &cs, clamp, lever, |c| Vec2::new(c[5], c[6]), v)?;
         }
+        // LAMMPS' Tsuji damping (its polynomial of e lane by lane).
+        lanes_match_alone::<Hertz, TsujiFit, TotalDisplacement>(Hertz, &cs, clamp, lever, |c| Vec2::new(c[5], c[6]), v)?;
     }
 }

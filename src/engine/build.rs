@@ -25,7 +25,7 @@ use crate::physics::walls::{Control, Surface, Wall};
 use crate::scene::grains::read_grain_file;
 use crate::scene::limits::{Limits, MemoryEstimate};
 use crate::scene::pack::relaxed_packing;
-use crate::scene::{Analysis, ControlSpec, Grains, Scene, SurfaceSpec, TangentialSpec, TimeStepRule};
+use crate::scene::{Analysis, ControlSpec, DampingSpec, Grains, Scene, SurfaceSpec, TangentialSpec, TimeStepRule};
 
 /// What was built, besides the engine.
 pub struct Built {
@@ -361,7 +361,13 @@ pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<B
     let tangential = if effects.friction { scene.model.tangential } else { TangentialSpec::Frictionless };
     let threads = crate::kernels::threads::Threads::new(threads)?;
     let parts = Parts { p, boundary, walls, dt, skin, scene, threads, domain, context };
+    let tsuji = scene.model.damping == DampingSpec::Tsuji;
     let engine: Box<dyn Engine> = match (scene.model.normal.hooke(), tangential, all_elastic) {
+        // LAMMPS' Tsuji damping (validation refused it with the incremental force).
+        (None, TangentialSpec::Frictionless, _) if tsuji => parts.assemble(HertzTsujiFrictionless::new(options, Hertz))?,
+        (None, _, _) if tsuji => parts.assemble(HertzTsujiHistory::new(options, Hertz))?,
+        (Some(h), TangentialSpec::Frictionless, _) if tsuji => parts.assemble(HookeTsujiFrictionless::new(options, h))?,
+        (Some(h), _, _) if tsuji => parts.assemble(HookeTsujiHistory::new(options, h))?,
         (None, TangentialSpec::Frictionless, false) => parts.assemble(HertzFrictionless::new(options, Hertz))?,
         (None, TangentialSpec::Frictionless, true) => parts.assemble(HertzFrictionlessElastic::new(options, Hertz))?,
         (None, TangentialSpec::TotalDisplacement, false) => parts.assemble(LiggghtsHertzHistory::new(options, Hertz))?,

@@ -111,11 +111,14 @@ impl Effects {
         };
         push("rotation (spin integration, torques)", rotation, rotation_why, Some("rotation off"));
         let lossy = pairs.iter().find(|q| mix(q).restitution < 1.0);
+        let tsuji = scene.model.damping == crate::scene::DampingSpec::Tsuji;
         let damping_why = match lossy {
+            _ if tsuji => "declared: model.damping = tsuji (LAMMPS' fit alpha(e) sqrt(m* k); alpha(1) = 3e-4 damps e = 1 too, and the realised e is not the input e)".to_string(),
             Some(&q) => format!("derived: the {} pair has restitution {} < 1", pair_name(mats, q), mix(&q).restitution),
             None => "derived: restitution = 1 for every pair of bodies that can touch".to_string(),
         };
-        push("contact damping", lossy.is_some(), damping_why, None);
+        let damping = lossy.is_some() || tsuji;
+        push(if tsuji { "contact damping (Tsuji, LAMMPS' fit)" } else { "contact damping" }, damping, damping_why, None);
         let clamp = scene.model.limit_force;
         push("normal force clamp (Fn >= 0)", clamp, format!("declared: model.limit_force = {clamp}"), Some("force clamp on"));
         let g = scene.gravity;
@@ -146,7 +149,7 @@ impl Effects {
         let frames = scene.output.frames;
         push("ParaView frames", frames > 0, format!("declared: output.frames = {frames}"), None);
         push("watchdog (overlaps, finite state)", true, "always".into(), None);
-        Effects { friction, rotation, damping: lossy.is_some(), list }
+        Effects { friction, rotation, damping, list }
     }
 
     /// The list as a table: each effect on or off, why, and what it cost where

@@ -163,6 +163,8 @@ impl Scene {
                 check(finite_pos(kt), "model.normal.hooke_stiffness", "kt", kt, "> 0 N/m")?;
             }
         }
+        let tsuji = self.model.damping == DampingSpec::Tsuji;
+        check(!(tsuji && self.model.tangential == TangentialSpec::IncrementalForce), "model", "damping", "tsuji", &format!("\"restitution\" with model.tangential = incremental_force (compiled: {})", crate::physics::contact::model::COMPILED))?;
         if let Some(c) = self.model.general_damping {
             check(finite_pos(c), "model", "general_damping", c, "> 0 1/s (omit it for none)")?;
         }

@@ -83,14 +83,16 @@ pub fn ladder() -> Vec<f64> {
 /// two grains of radius `r` and `material` at `speed`, with the clamp as given, under
 /// the Hertz law.
 pub fn calibrate(material: &Material, r: f64, speed: f64, limit_force: bool, quantity: AccuracyQuantity, tolerance: f64) -> Result<Calibration, Error> {
-    calibrate_under(crate::scene::NormalLaw::Hertz, material, r, speed, limit_force, quantity, tolerance)
+    calibrate_under(crate::scene::NormalLaw::Hertz, crate::scene::DampingSpec::Restitution, material, r, speed, limit_force, quantity, tolerance)
 }
 
-/// [`calibrate`] under the normal law `law` (steps per its contact time).
-pub fn calibrate_under(law: crate::scene::NormalLaw, material: &Material, r: f64, speed: f64, limit_force: bool, quantity: AccuracyQuantity, tolerance: f64) -> Result<Calibration, Error> {
+/// [`calibrate`] under the normal law `law` (steps per its contact time) and `damping`.
+#[allow(clippy::too_many_arguments)]
+pub fn calibrate_under(law: crate::scene::NormalLaw, damping: crate::scene::DampingSpec, material: &Material, r: f64, speed: f64, limit_force: bool, quantity: AccuracyQuantity, tolerance: f64) -> Result<Calibration, Error> {
     let run = |n: f64| -> Result<ImpactSummary, Error> {
         let mut s = crate::scene::builtin::head_on_under(law, material.clone(), r, speed, n);
         s.model.limit_force = limit_force;
+        s.model.damping = damping;
         s.model.tangential = crate::scene::TangentialSpec::Frictionless;
         s.output.energy = false;
         s.time_step.allow_unstable = true;
@@ -145,7 +147,7 @@ pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<B
     };
     scene.validate()?;
     let (r, material) = scene.smallest_grain(limits)?;
-    let cal = calibrate_under(scene.model.normal, &scene.materials[material], r, impact_speed, scene.model.limit_force, quantity, tolerance)?;
+    let cal = calibrate_under(scene.model.normal, scene.model.damping, &scene.materials[material], r, impact_speed, scene.model.limit_force, quantity, tolerance)?;
     let mut resolved = scene.clone();
     resolved.time_step.rule = TimeStepRule::StepsPerContact { steps: cal.steps_per_contact, impact_speed };
     let mut built = crate::engine::build::build_limited(&resolved, threads, limits)?;

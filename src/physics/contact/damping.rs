@@ -12,6 +12,10 @@
 //! (computed once per neighbour-list build): one square root per contact and step instead
 //! of two.
 //!
+//! [`TsujiFit`]: LAMMPS' `damping tsuji`, `gn = alpha(e) sqrt(m* kn)` with kn the secant
+//! normal stiffness and alpha LAMMPS' polynomial fit ([`tsuji_alpha`]), for either normal
+//! law; it does not return e.
+//!
 //! [`LinearRestitution`], for the linear spring ([`super::normal::Hooke`]):
 //! `gn = -2 beta sqrt(m* kn)`, `gt = -2 beta sqrt(m* kt)`, the same beta(e). The linear
 //! spring-dashpot `m* x'' + gn x' + kn x = 0` leaves contact (x = 0, the force allowed to
@@ -53,6 +57,32 @@ impl Damping for Undamped {
     #[inline(always)]
     fn coefficients<R: Real>(_: &PairMaterial<R>, _: R, _: &Stiffness<R>) -> (R, R) {
         (R::zero(), R::zero())
+    }
+}
+
+/// LAMMPS' `damping tsuji` coefficient of the restitution `e`, in LAMMPS' order of terms
+/// (GRANULAR's pair_granular.cpp and fix_wall_gran.cpp, 29Sep2021: a fit after Tsuji et
+/// al. 1992).
+#[inline(always)]
+pub fn tsuji_alpha<R: Real>(e: R) -> R {
+    let (e2, e3) = (e * e, e * e * e);
+    let (e4, e5, e6) = (e3 * e, e3 * e2, e3 * e3);
+    k::<R>(1.2728) - k::<R>(4.2783) * e + k::<R>(11.087) * e2 - k::<R>(22.348) * e3 + k::<R>(27.467) * e4 - k::<R>(18.022) * e5 + k::<R>(4.8218) * e6
+}
+
+/// LAMMPS' `damping tsuji` (`model.damping = "tsuji"`): `gn = alpha(e) sqrt(m* kn)`,
+/// `gt = alpha(e) sqrt(m* kt)` with the secant stiffnesses of the normal law and
+/// [`tsuji_alpha`] of the pair's restitution. The realised restitution is not e (see
+/// [`crate::scene::DampingSpec::Tsuji`]).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct TsujiFit;
+
+impl Damping for TsujiFit {
+    const NAME: &'static str = "Tsuji";
+    #[inline(always)]
+    fn coefficients<R: Real>(pm: &PairMaterial<R>, sqrt_m_star: R, st: &Stiffness<R>) -> (R, R) {
+        let c = tsuji_alpha(pm.restitution) * sqrt_m_star;
+        (c * st.kn.simd_sqrt(), c * st.kt.simd_sqrt())
     }
 }
 

@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 
 use nalgebra::Vector2;
 
-use super::damping::{Damping, LinearRestitution, Undamped, Viscoelastic};
+use super::damping::{Damping, LinearRestitution, TsujiFit, Undamped, Viscoelastic};
 use super::normal::{Hertz, Hooke, Normal};
 use super::tangential::{Frictionless, IncrementalForce, Tangential, TangentialForce, TangentialInput, TotalDisplacement};
 use crate::physics::dim::Vec2;
@@ -403,5 +403,12 @@ pub type LiggghtsHookeHistoryElastic = ContactModel<Hooke, Undamped, TotalDispla
 pub type HookeIncremental = ContactModel<Hooke, LinearRestitution, IncrementalForce>;
 pub type HookeIncrementalElastic = ContactModel<Hooke, Undamped, IncrementalForce>;
 
+/// LAMMPS `pair granular ... damping tsuji` (`model.damping = "tsuji"`), either normal
+/// law, frictionless or with the total-displacement history.
+pub type HertzTsujiFrictionless = ContactModel<Hertz, TsujiFit, Frictionless>;
+pub type HertzTsujiHistory = ContactModel<Hertz, TsujiFit, TotalDisplacement>;
+pub type HookeTsujiFrictionless = ContactModel<Hooke, TsujiFit, Frictionless>;
+pub type HookeTsujiHistory = ContactModel<Hooke, TsujiFit, TotalDisplacement>;
+
 /// The names of the compiled combinations, for a refusal.
-pub const COMPILED: &str = "normal hertz or hooke (hooke_stiffness), each with damping (beta(e); the linear spring's constant-restitution form) or none (every e = 1), and tangential total_displacement, incremental_force or frictionless";
+pub const COMPILED: &str = "normal hertz or hooke (hooke_stiffness), each with damping (beta(e); the linear spring's constant-restitution form) or none (every e = 1), and tangential total_displacement, incremental_force or frictionless; damping tsuji with either normal law, total_displacement or frictionless";

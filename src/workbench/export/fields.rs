@@ -296,6 +296,12 @@ pub const FIELDS: &[Field] = &[
     )
     .in_lammps(written(SPRING_M)),
     each(
+        "model.damping",
+        refused("\"tsuji\": LIGGGHTS 3.8's `model hertz` and `model hooke` damp with beta(e) only; it has no Tsuji fit"),
+        refused("\"tsuji\": YADE's Mindlin law damps with betan, betas only; it has no Tsuji fit"),
+    )
+    .in_lammps(written("\"restitution\": `damping tsuji` with the input that gives grainlab's damping (materials[].restitution); \"tsuji\": `damping tsuji` with each pair's restitution as its input, LAMMPS' own fit, and X = sqrt(kt / kn)")),
+    each(
         "model.tangential",
         written("total_displacement: `pair_style gran model hertz tangential history`; frictionless: coefficientFriction 0 (Ft = 0) and `nve`")
             .or_differs("incremental_force", "LIGGGHTS has only the total-displacement history; head-on impacts agree, oblique ones differ (rebound spin up to 2x)"),

@@ -35,14 +35,9 @@ use crate::error::Error;
 use crate::physics::material::PairMaterial;
 use crate::physics::particles::Particles;
 use crate::physics::walls::Wall;
-use crate::scene::{NormalLaw, Scene, TangentialSpec};
+use crate::scene::{DampingSpec, NormalLaw, Scene, TangentialSpec};
 
-/// LAMMPS' `damping tsuji` coefficient of its input `c` (GRANULAR's pair_granular.cpp and
-/// fix_wall_gran.cpp, LAMMPS 29Sep2021): a fit of Tsuji et al. (1992), written as LAMMPS
-/// evaluates it.
-pub fn tsuji_alpha(c: f64) -> f64 {
-    1.2728 - 4.2783 * c + 11.087 * c.powi(2) - 22.348 * c.powi(3) + 27.467 * c.powi(4) - 18.022 * c.powi(5) + 4.8218 * c.powi(6)
-}
+pub use crate::physics::contact::damping::tsuji_alpha;
 
 /// The input c for which LAMMPS' Tsuji polynomial gives `alpha` (> 0). The polynomial
 /// falls monotonically on [-1, 1.1] from 89.1 to -0.05 (tested), so every alpha of a
@@ -169,7 +164,15 @@ fn words(scene: &Scene, pm: &PairMaterial, kinds: &[(f64, f64)], what: &str) -> 
             (("hooke", kn), kn, "linear_history", 2.0 * beta, 1.0)
         }
     };
-    let (damping, d) = if beta == 0.0 { ("viscoelastic", 0.0) } else { ("tsuji", tsuji_input(alpha)) };
+    let (damping, d, ratio) = if scene.model.damping == DampingSpec::Tsuji {
+        // grainlab's Tsuji damping is LAMMPS' own: the restitution is its input, and the
+        // tangential damping alpha sqrt(m* kt) is sqrt(kt / kn) times the normal one.
+        ("tsuji", pm.restitution, (kt / normal.1).sqrt())
+    } else if beta == 0.0 {
+        ("viscoelastic", 0.0, ratio)
+    } else {
+        ("tsuji", tsuji_input(alpha), ratio)
+    };
     let limit = if model.limit_force { " limit_damping" } else { "" };
     Ok(format!("{} {} {} tangential {tangential} {} {} {} damping {damping}{limit}", normal.0, f(normal.1), f(d), f(kt), f(ratio), f(mu)))
 }
@@ -254,7 +257,7 @@ mod tests {
         let mut last = f64::INFINITY;
         for k in 0..=21000 {
             let c = -1.0 + 2.1 * k as f64 / 21000.0;
-            let a = tsuji_alpha(c);
+            let a = tsuji_alpha(c as f64);
             assert!(a < last, "not falling at {c}");
             last = a;
         }

@@ -29,6 +29,9 @@ pub(crate) fn prepare(scene: &Scene, code: Code, limits: &crate::scene::limits::
     {
         return Err(fields::refuse(code, "gravity", format!("[{gx}, {gy}]"), ""));
     }
+    if scene.model.damping == crate::scene::DampingSpec::Tsuji && code != Code::Lammps {
+        return Err(fields::refuse(code, "model.damping", "\"tsuji\"", ""));
+    }
     if let Some(c) = scene.model.general_damping {
         return Err(fields::refuse(code, "model.general_damping", c, ""));
     }
