@@ -58,9 +58,9 @@
 //!    ([`study::sweep`]); the accuracy calibration that picks a
 //!    time step for a stated accuracy before the engine is built ([`study::accuracy`]).
 //! 8. **Workbench** ([`workbench`]): the reference cases under `reference/`
-//!    ([`workbench::cases`](mod@workbench::cases)), the digest of LIGGGHTS' and YADE's output with the engine's
+//!    ([`workbench::cases`](mod@workbench::cases)), the digest of LIGGGHTS', YADE's and LAMMPS' output with the engine's
 //!    own observers ([`workbench::digest`](mod@workbench::digest)), the comparison ([`workbench::compare`]); the
-//!    exporter writes any scene as a deck for either code, exactly or refused by name
+//!    exporter writes any scene as a deck for each code, exactly or refused by name
 //!    ([`workbench::export`]); frozen states the codes evaluate without moving, to
 //!    check what the packing observers read ([`workbench::frozen`]).
 //!

@@ -121,7 +121,7 @@ fn lammps_matches_to_rounding_where_its_contact_model_is_grainlab_s() {
     // points, the clamp as `limit_damping`, e = 0.1 through an input below 0), the linear
     // spring's grid (24 points), a grain on a flat wall at e = 1 with friction (lever arm
     // r: LAMMPS' wall/gran kinematics, and without damping its history is grainlab's total
-    // displacement) and frictionless oblique pairs, 5 to 85 degrees. Held to the issue's
+    // displacement) and frictionless oblique pairs, 5 to 85 degrees; and the Tsuji damping. Held to the issue's
     // bounds, and to 1e-9 (relative, or absolute for e): the same model at the same dt
     // agrees to rounding. Measured: e within 2e-15, peak forces 4e-15, spins 1e-14; the
     // largest overlap within 3e-11 (e = 0.1, v = 0.01 m/s, t_c/50: an overlap of 1e-8 m
@@ -136,6 +136,12 @@ fn lammps_matches_to_rounding_where_its_contact_model_is_grainlab_s() {
         assert_eq!(oblique.len(), 7 * 5, "{prefix}");
         rows.extend(oblique);
     }
+    // grainlab's Tsuji damping (model.damping = "tsuji") is LAMMPS' `damping tsuji` with
+    // the restitution as its input: head-on grids under Hertz (24 points) and the given
+    // spring (6), frictionless oblique impacts on a wall and a grain.
+    let tsuji = check_all("tsuji", Code::Lammps);
+    assert_eq!(tsuji.len(), 32 * 3);
+    rows.extend(tsuji);
     for r in &rows {
         assert!(r.diff() <= 1e-9, "{} {}: engine {} vs lammps {} (diff {:e}): not rounding", r.case, r.quantity, r.engine, r.reference, r.diff());
     }

@@ -164,6 +164,43 @@ fn lammps_cases(out: &mut Vec<Case>) {
         s.description = format!("glass bead on a resting one at 1 m/s, {a} deg from the line of centres, e = 0.9, frictionless, t_c/200");
         out.push(Case { info: CaseInfo { name, description: s.description.clone(), codes: vec![Code::Lammps], quick: a == 45.0, curve: false, ensemble: None }, scene: s });
     }
+    tsuji_cases(out);
+}
+
+/// LAMMPS' Tsuji damping (`model.damping = "tsuji"`), which only LAMMPS has: head-on
+/// grids under Hertz (e = 0.1 to 1, t_c/50 and t_c/500, clamp on and off) and the given
+/// spring (e = 0.1, 0.5, 0.9 at t_c/500), and frictionless oblique impacts at 45 degrees
+/// on a flat wall and on a resting grain. `tsuji/...`.
+fn tsuji_cases(out: &mut Vec<Case>) {
+    use crate::scene::{DampingSpec, NormalLaw};
+    for (tag, law, es, ns) in [
+        ("hertz", NormalLaw::Hertz, &[0.1, 0.3, 0.5, 0.7, 0.9, 1.0][..], &[50.0, 500.0][..]),
+        ("spring", NormalLaw::HookeStiffness { kn: SPRING_KN, kt: SPRING_KT }, &[0.1, 0.5, 0.9][..], &[500.0][..]),
+    ] {
+        for &e in es {
+            for &n in ns {
+                for clamp in [false, true] {
+                    let mut s = builtin::head_on_under(law, glass(e), 1e-3, 1.0, n);
+                    s.model.damping = DampingSpec::Tsuji;
+                    s.model.limit_force = clamp;
+                    let name = format!("tsuji/{tag}-e{}-n{}-{}", num(e), num(n), if clamp { "clamp" } else { "free" });
+                    s.name = name.replace('/', "-");
+                    s.description = format!("head-on glass beads r = 1 mm, {tag}, Tsuji damping (LAMMPS' fit) of e = {e}, v = 1 m/s, dt = t_c/{n}, Fn clamp {}", if clamp { "on" } else { "off" });
+                    out.push(Case { info: CaseInfo { name, description: s.description.clone(), codes: vec![Code::Lammps], quick: n == 500.0, curve: false, ensemble: None }, scene: s });
+                }
+            }
+        }
+    }
+    let mut s = builtin::oblique(glass(0.5), 1e-3, 1.0, 45.0, TangentialSpec::Frictionless, 200.0);
+    s.model.damping = DampingSpec::Tsuji;
+    s.name = "tsuji-wall-frictionless-a45".into();
+    s.description = "glass bead on a flat glass wall at 1 m/s, 45 deg, frictionless, Tsuji damping of e = 0.5, t_c/200".into();
+    out.push(Case { info: CaseInfo { name: "tsuji/wall-frictionless-a45".into(), description: s.description.clone(), codes: vec![Code::Lammps], quick: true, curve: false, ensemble: None }, scene: s });
+    let mut s = builtin::oblique_pair(glass(0.5), 1e-3, 1.0, 45.0, TangentialSpec::Frictionless, 200.0);
+    s.model.damping = DampingSpec::Tsuji;
+    s.name = "tsuji-pair-frictionless-a45".into();
+    s.description = "glass bead on a resting one at 1 m/s, 45 deg, frictionless, Tsuji damping of e = 0.5, t_c/200".into();
+    out.push(Case { info: CaseInfo { name: "tsuji/pair-frictionless-a45".into(), description: s.description.clone(), codes: vec![Code::Lammps], quick: true, curve: false, ensemble: None }, scene: s });
 }
 
 /// The linear spring against LIGGGHTS (`model hooke` and `hooke/stiffness`, tangential

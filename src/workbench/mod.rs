@@ -8,8 +8,8 @@
 //! digest`, which measures it with the engine's own observers (the same estimator on
 //! both sides) into `expected/<code>/`. `grainlab compare` and `tests/workbench.rs` run
 //! the engine on each case and hold it to the committed numbers. The exporter
-//! ([`export`]) writes any scene as a LIGGGHTS deck or a YADE script, exactly or not at
-//! all. May use: everything below it (`study`, `output`, `observe`, `engine`, `scene`,
+//! ([`export`]) writes any scene as a LIGGGHTS deck, a YADE script or a LAMMPS deck, exactly or
+//! not at all. May use: everything below it (`study`, `output`, `observe`, `engine`, `scene`,
 //! `physics`).
 
 pub mod cases;
