@@ -173,6 +173,9 @@ fn words(scene: &Scene, pm: &PairMaterial, kinds: &[(f64, f64)], what: &str) -> 
     } else {
         ("tsuji", tsuji_input(alpha), ratio)
     };
+    // A ratio of two coefficients that underflowed to 0 (moduli near the smallest double):
+    // both damping forces are then 0 in grainlab, and X times LAMMPS' 0 is 0 whatever X.
+    let ratio = if ratio.is_finite() { ratio } else { 0.0 };
     let limit = if model.limit_force { " limit_damping" } else { "" };
     Ok(format!("{} {} {} tangential {tangential} {} {} {} damping {damping}{limit}", normal.0, f(normal.1), f(d), f(kt), f(ratio), f(mu)))
 }
@@ -249,6 +252,22 @@ mod tests {
         assert_eq!(contact_kinds(1, &grains(&[1e-3, 2e-3, 3e-3], 3), &[]).pairs[0].len(), 2);
         // A free grain and a glued one of another size: one kind.
         assert_eq!(contact_kinds(1, &grains(&[1e-3, 2e-3], 1), &[]).pairs[0].len(), 1);
+    }
+
+    #[test]
+    fn a_modulus_near_the_smallest_double_writes_finite_numbers() {
+        // The fuzzer's case: a second material of E = 5e-324, whose mixed E* and G*
+        // underflow, made the tangential damping ratio 0 / 0.
+        let mut s = crate::scene::builtin::builtin("collision").unwrap();
+        s.materials.push(crate::physics::material::Material { youngs_modulus: 5e-324, ..s.materials[0].clone() });
+        if let crate::scene::Grains::List(l) = &mut s.grains {
+            l[1].material = 1;
+        }
+        for damping in [crate::scene::DampingSpec::Restitution, crate::scene::DampingSpec::Tsuji] {
+            s.model.damping = damping;
+            let files = super::super::export_files(&s, Code::Lammps, false, &Default::default()).unwrap();
+            assert!(!files[0].1.to_ascii_lowercase().contains("nan") && !files[0].1.contains("inf"), "{}", files[0].1);
+        }
     }
 
     #[test]
