@@ -7,8 +7,9 @@
 //! 1. **Physics** ([`physics`]): what a grain is ([`physics::dim`]: the plane, sphere in
 //!    the plane or disk; [`physics::particles`]: grain state as struct of arrays), the
 //!    materials and their mixing ([`physics::material`]), the contact law composed at
-//!    compile time ([`physics::contact`]: a normal law, Hertz or the linear spring, a damping form, a tangential
-//!    formulation, LIGGGHTS' total displacement or YADE's increments, one monomorphized
+//!    compile time ([`physics::contact`]: a normal law, Hertz or the linear spring; a
+//!    damping form, the one that returns e or LAMMPS' Tsuji fit; a tangential
+//!    formulation, LIGGGHTS' total displacement or YADE's increments; one monomorphized
 //!    kernel per named combination), written once over its number type to run one
 //!    contact or four in SIMD lanes with the same bits ([`physics::lanes`]); walls, flat
 //!    or rough, fixed or loaded ([`physics::walls`]), the periodic boundary in x
