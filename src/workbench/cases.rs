@@ -191,16 +191,15 @@ fn tsuji_cases(out: &mut Vec<Case>) {
             }
         }
     }
-    let mut s = builtin::oblique(glass(0.5), 1e-3, 1.0, 45.0, TangentialSpec::Frictionless, 200.0);
-    s.model.damping = DampingSpec::Tsuji;
-    s.name = "tsuji-wall-frictionless-a45".into();
-    s.description = "glass bead on a flat glass wall at 1 m/s, 45 deg, frictionless, Tsuji damping of e = 0.5, t_c/200".into();
-    out.push(Case { info: CaseInfo { name: "tsuji/wall-frictionless-a45".into(), description: s.description.clone(), codes: vec![Code::Lammps], quick: true, curve: false, ensemble: None }, scene: s });
-    let mut s = builtin::oblique_pair(glass(0.5), 1e-3, 1.0, 45.0, TangentialSpec::Frictionless, 200.0);
-    s.model.damping = DampingSpec::Tsuji;
-    s.name = "tsuji-pair-frictionless-a45".into();
-    s.description = "glass bead on a resting one at 1 m/s, 45 deg, frictionless, Tsuji damping of e = 0.5, t_c/200".into();
-    out.push(Case { info: CaseInfo { name: "tsuji/pair-frictionless-a45".into(), description: s.description.clone(), codes: vec![Code::Lammps], quick: true, curve: false, ensemble: None }, scene: s });
+    type Oblique = fn(Material, f64, f64, f64, TangentialSpec, f64) -> Scene;
+    for (target, builder, what) in [("wall", builtin::oblique as Oblique, "a flat glass wall"), ("pair", builtin::oblique_pair, "a resting one")] {
+        let mut s = builder(glass(0.5), 1e-3, 1.0, 45.0, TangentialSpec::Frictionless, 200.0);
+        s.model.damping = DampingSpec::Tsuji;
+        let name = format!("tsuji/{target}-frictionless-a45");
+        s.name = name.replace('/', "-");
+        s.description = format!("glass bead on {what} at 1 m/s, 45 deg, frictionless, Tsuji damping of e = 0.5, t_c/200");
+        out.push(Case { info: CaseInfo { name, description: s.description.clone(), codes: vec![Code::Lammps], quick: true, curve: false, ensemble: None }, scene: s });
+    }
 }
 
 /// The linear spring against LIGGGHTS (`model hooke` and `hooke/stiffness`, tangential

@@ -81,14 +81,17 @@ pub(crate) fn deck(scene: &Scene, ex: &Exported, code: Code) -> Result<String, E
     let _ = writeln!(w, "read_data grains.data");
     let skin = scene.neighbor.skin * 2.0 * p.r[..p.n_free].iter().cloned().fold(f64::INFINITY, f64::min);
     let _ = writeln!(w, "neighbor {} bin\nneigh_modify delay 0", f(skin));
-    let law = if lammps {
-        super::lammps::pair_style(w, scene, ex)?;
-        String::new()
+    // LAMMPS: the contacts each pair of types and each flat wall can make, for its
+    // pair_coeff lines and wall fixes; LIGGGHTS: the model words its pair style and
+    // wall/gran fixes share.
+    let (kinds, law) = if lammps {
+        let kinds = super::lammps::kinds(scene, ex);
+        super::lammps::pair_style(w, scene, &kinds)?;
+        (Some(kinds), String::new())
     } else {
         let _ = writeln!(w, "hard_particles yes");
-        materials(w, scene, ex)?
+        (None, materials(w, scene, ex)?)
     };
-    let frictionless = !frictional;
     let _ = writeln!(w, "timestep {}", f(info.time_step_s));
     let _ = writeln!(w, "group free id <> 1 {}", p.n_free);
     let _ = writeln!(w, "run 0");
@@ -98,10 +101,10 @@ pub(crate) fn deck(scene: &Scene, ex: &Exported, code: Code) -> Result<String, E
         match &wall.surface {
             Surface::Flat => {
                 let shear = if wall.v.x != 0.0 { format!(" shear x {}", f(wall.v.x)) } else { String::new() };
-                if lammps {
+                if let Some(kinds) = &kinds {
                     // The bottom wall holds the grains above it (LO), the top one below (HI).
                     let plane = if wall.side > 0.0 { format!("yplane {} NULL{shear}", f(wall.y)) } else { format!("yplane NULL {}{shear}", f(wall.y)) };
-                    super::lammps::flat_wall(w, scene, ex, index, &plane)?;
+                    super::lammps::flat_wall(w, scene, ex, kinds, index, &plane)?;
                 } else {
                     let _ = writeln!(w, "fix w_{name} free wall/gran {law} primitive type {} yplane {}{shear}", wall.material + 1 /* its material's atom type */, f(wall.y));
                 }
@@ -126,7 +129,7 @@ pub(crate) fn deck(scene: &Scene, ex: &Exported, code: Code) -> Result<String, E
             }
         }
     }
-    let rotation = model.rotation && !frictionless;
+    let rotation = model.rotation && frictional;
     let _ = writeln!(w, "fix integrate free {}", if rotation { "nve/sphere" } else { "nve" });
     let _ = writeln!(w, "variable s equal step");
     let record = if ex.bench { Analysis::None } else { info.analysis };
@@ -337,7 +340,7 @@ fn spring_rates(scene: &Scene, p: &crate::physics::particles::Particles, walls: 
     let n = scene.materials.len();
     // The reduced masses each pair of types meets at: grain pairs, and grains on flat
     // walls (m* = m), whose wall/gran fixes share the pair style's table.
-    let kinds = super::lammps::contact_kinds(n, p, walls);
+    let kinds = super::lammps::contact_kinds(n, p, walls, |_, _, m_star, _| m_star);
     let same = |x: f64, m: f64| (x - m).abs() <= 1e-12 * m;
     let mut stars: Vec<Vec<f64>> = vec![Vec::new(); n * n];
     let mut add = |a: usize, b: usize, m: f64| {
@@ -349,14 +352,14 @@ fn spring_rates(scene: &Scene, p: &crate::physics::particles::Particles, walls: 
     };
     for a in 0..n {
         for b in 0..n {
-            for &(m, _) in &kinds.pairs[a * n + b] {
+            for &m in &kinds.pairs[a * n + b] {
                 add(a, b, m);
             }
         }
     }
     for (wall, per) in walls.iter().zip(&kinds.walls) {
         for (a, list) in per.iter().enumerate() {
-            for &(m, _) in list {
+            for &m in list {
                 add(a, wall.material, m);
             }
         }
