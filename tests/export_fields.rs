@@ -350,7 +350,7 @@ fn json_of(s: &Scene) -> Value {
 
 /// A second material, of restitution `e` (YADE takes one restitution for all pairs).
 fn steel(e: f64) -> grainlab::physics::material::Material {
-    grainlab::physics::material::Material { name: "steel".into(), youngs_modulus: 200e9, poisson_ratio: 0.3, density: 7800.0, restitution: e, friction: 0.3 }
+    grainlab::physics::material::Material { name: "steel".into(), youngs_modulus: 200e9, poisson_ratio: 0.3, density: 7800.0, restitution: e, friction: 0.3, work_of_adhesion: 0.0 }
 }
 
 fn bases(dir: &Path) -> Vec<Base> {
@@ -457,6 +457,17 @@ fn bases(dir: &Path) -> Vec<Base> {
     let mut damped = json_of(&collision);
     damped["model"]["damping"] = json!("restitution");
     out.push(Base { name: "collision-damping", scene: damped, only: &["model.damping"], variant_of: None });
+    // The work of adhesion, written out at 0 (written scenes leave it out): the walk
+    // moves it above 0, DMT cohesion (LAMMPS alone, Hertz only), on the Hertz pair and
+    // under the given spring.
+    let mut adhesion = json_of(&collision);
+    adhesion["materials"][0]["work_of_adhesion"] = json!(0.0);
+    out.push(Base { name: "collision-adhesion", scene: adhesion, only: &["materials"], variant_of: None });
+    let mut s = collision.clone();
+    s.model.normal = NormalLaw::HookeStiffness { kn: 2e5, kt: 1e5 };
+    let mut adhesion = json_of(&s);
+    adhesion["materials"][0]["work_of_adhesion"] = json!(0.0);
+    out.push(Base { name: "collision-spring-adhesion", scene: adhesion, only: &["materials"], variant_of: None });
     let mut s = collision.clone();
     s.model.normal = NormalLaw::Hooke { characteristic_velocity: 1.0 };
     out.push(variant("collision-hooke", &s, "collision", "model.normal", &["model.normal"]));

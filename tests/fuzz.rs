@@ -133,6 +133,17 @@ fn bases(dir: &Path) -> Vec<Value> {
     let mut tsuji = json(&shear);
     tsuji["model"]["damping"] = "tsuji".into();
     out.push(tsuji);
+    // DMT cohesion in the loaded shear cell (strong: a pull-off force near the contact
+    // forces of 100 kPa), and on a pair of grains under the given spring.
+    let mut dmt = json(&shear);
+    for m in dmt["materials"].as_array_mut().unwrap() {
+        m["work_of_adhesion"] = json!(20.0);
+    }
+    out.push(dmt);
+    let mut dmt_pair = json(&builtin::builtin("collision").unwrap());
+    dmt_pair["materials"][0]["work_of_adhesion"] = json!(1.0);
+    dmt_pair["model"]["normal"] = json!({"hooke_stiffness": {"kn": 2e5, "kt": 1.5e5}});
+    out.push(dmt_pair);
     out
 }
 

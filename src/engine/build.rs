@@ -12,6 +12,7 @@ use crate::engine::world::World;
 use crate::error::{Error, Shown};
 use crate::kernels::pairs::PairList;
 use crate::physics::boundary::Boundary;
+use crate::physics::contact::cohesion::Cohesion;
 use crate::physics::contact::damping::Damping;
 use crate::physics::contact::normal::{Hertz, Normal};
 use crate::physics::contact::model::*;
@@ -363,6 +364,12 @@ pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<B
     let parts = Parts { p, boundary, walls, dt, skin, scene, threads, domain, context };
     let tsuji = scene.model.damping == DampingSpec::Tsuji;
     let engine: Box<dyn Engine> = match (scene.model.normal.hooke(), tangential, all_elastic) {
+        // DMT cohesion, with the restitution damping (0 when every e = 1); validation
+        // refused it with the incremental force, Tsuji's damping and the clamp.
+        (None, TangentialSpec::Frictionless, _) if effects.cohesion => parts.assemble(HertzDmtFrictionless::new(options, Hertz))?,
+        (None, _, _) if effects.cohesion => parts.assemble(HertzDmtHistory::new(options, Hertz))?,
+        (Some(h), TangentialSpec::Frictionless, _) if effects.cohesion => parts.assemble(HookeDmtFrictionless::new(options, h))?,
+        (Some(h), _, _) if effects.cohesion => parts.assemble(HookeDmtHistory::new(options, h))?,
         // LAMMPS' Tsuji damping (validation refused it with the incremental force).
         (None, TangentialSpec::Frictionless, _) if tsuji => parts.assemble(HertzTsujiFrictionless::new(options, Hertz))?,
         (None, _, _) if tsuji => parts.assemble(HertzTsujiHistory::new(options, Hertz))?,
@@ -428,12 +435,12 @@ struct Parts<'a> {
 }
 
 impl Parts<'_> {
-    fn assemble<N: Normal, Dm: Damping, T: Tangential>(self, law: ContactModel<N, Dm, T>) -> Result<Box<dyn Engine>, Error> {
-        if self.scene.output.energy { self.assemble_with::<N, Dm, T, true>(law) } else { self.assemble_with::<N, Dm, T, false>(law) }
+    fn assemble<N: Normal, Dm: Damping, T: Tangential, C: Cohesion>(self, law: ContactModel<N, Dm, T, C>) -> Result<Box<dyn Engine>, Error> {
+        if self.scene.output.energy { self.assemble_with::<N, Dm, T, C, true>(law) } else { self.assemble_with::<N, Dm, T, C, false>(law) }
     }
 
-    fn assemble_with<N: Normal, Dm: Damping, T: Tangential, const E: bool>(self, law: ContactModel<N, Dm, T>) -> Result<Box<dyn Engine>, Error> {
-        type L<N, Dm, T> = ContactModel<N, Dm, T>;
+    fn assemble_with<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, const E: bool>(self, law: ContactModel<N, Dm, T, C>) -> Result<Box<dyn Engine>, Error> {
+        type L<N, Dm, T, C> = ContactModel<N, Dm, T, C>;
         let scene = self.scene;
         let rotation = T::FRICTION && scene.model.rotation;
         let has_walls = !self.walls.is_empty();
@@ -470,9 +477,9 @@ impl Parts<'_> {
         };
         // The force stages, shared by the step and by the set-up at t = 0.
         let threads = self.threads.clone();
-        type Stages<N, Dm, T> = Vec<Box<dyn Stage<L<N, Dm, T>>>>;
-        let forces = || -> Result<Stages<N, Dm, T>, Error> {
-            let mut s: Stages<N, Dm, T> = vec![Box::new(UpdateNeighbours), Box::new(ClearForces)];
+        type Stages<N, Dm, T, C> = Vec<Box<dyn Stage<L<N, Dm, T, C>>>>;
+        let forces = || -> Result<Stages<N, Dm, T, C>, Error> {
+            let mut s: Stages<N, Dm, T, C> = vec![Box::new(UpdateNeighbours), Box::new(ClearForces)];
             if pulled {
                 s.push(Box::new(Gravity::<E>));
             }
@@ -482,13 +489,13 @@ impl Parts<'_> {
             if scene.output.contacts {
                 s.push(if rotation { Box::new(RecordContacts::<true>) } else { Box::new(RecordContacts::<false>) });
             }
-            s.push(if rotation { pair_stage::<N, Dm, T, E, true>(&threads) } else { pair_stage::<N, Dm, T, E, false>(&threads) });
+            s.push(if rotation { pair_stage::<N, Dm, T, C, E, true>(&threads) } else { pair_stage::<N, Dm, T, C, E, false>(&threads) });
             if has_flat {
                 s.push(Box::new(FlatWallForces::<E>));
             }
             Ok(s)
         };
-        let mut stages: Stages<N, Dm, T> = Vec::new();
+        let mut stages: Stages<N, Dm, T, C> = Vec::new();
         // The walls first: their grains follow them in the drift.
         if has_walls {
             stages.push(Box::new(MoveWalls));
@@ -518,7 +525,7 @@ impl Parts<'_> {
 
 /// The grain-grain contact stage: serial, or on the run's pool of threads; with `SPIN` when
 /// the grains rotate (without, the kernel neither reads spins nor computes torques).
-fn pair_stage<N: Normal, Dm: Damping, T: Tangential, const E: bool, const SPIN: bool>(threads: &crate::kernels::threads::Threads) -> Box<dyn Stage<ContactModel<N, Dm, T>>> {
+fn pair_stage<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, const E: bool, const SPIN: bool>(threads: &crate::kernels::threads::Threads) -> Box<dyn Stage<ContactModel<N, Dm, T, C>>> {
     #[cfg(feature = "parallel")]
     if threads.count() > 1 {
         return Box::new(crate::engine::parallel::ParallelPairForces::<E, SPIN>::new(threads.clone()));

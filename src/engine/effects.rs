@@ -41,6 +41,8 @@ pub struct Effects {
     pub rotation: bool,
     /// Contacts are damped: some pair that can touch has a restitution below 1.
     pub damping: bool,
+    /// Contacts attract (DMT): some pair that can touch has a work of adhesion above 0.
+    pub cohesion: bool,
     pub list: Vec<Effect>,
 }
 
@@ -119,6 +121,14 @@ impl Effects {
         };
         let damping = lossy.is_some() || tsuji;
         push(if tsuji { "contact damping (Tsuji, LAMMPS' fit)" } else { "contact damping" }, damping, damping_why, None);
+        // Cohesion: derived from the works of adhesion of the pairs that can touch.
+        let sticky = pairs.iter().find(|q| mix(q).pulloff > 0.0);
+        let cohesion_why = match sticky {
+            Some(&q) => format!("derived: the {} pair has work of adhesion {} J/m^2 (DMT: attraction 2 pi w R* while overlapping)", pair_name(mats, q), mix(&q).pulloff / (2.0 * std::f64::consts::PI)),
+            None => "derived: work_of_adhesion = 0 for every pair of bodies that can touch".to_string(),
+        };
+        let cohesion = sticky.is_some();
+        push("cohesion (DMT)", cohesion, cohesion_why, None);
         let clamp = scene.model.limit_force;
         push("normal force clamp (Fn >= 0)", clamp, format!("declared: model.limit_force = {clamp}"), Some("force clamp on"));
         let g = scene.gravity;
@@ -149,7 +159,7 @@ impl Effects {
         let frames = scene.output.frames;
         push("ParaView frames", frames > 0, format!("declared: output.frames = {frames}"), None);
         push("watchdog (overlaps, finite state)", true, "always".into(), None);
-        Effects { friction, rotation, damping, list }
+        Effects { friction, rotation, damping, cohesion, list }
     }
 
     /// The list as a table: each effect on or off, why, and what it cost where

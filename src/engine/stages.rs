@@ -9,6 +9,7 @@ use crate::engine::world::World;
 use crate::error::Error;
 use crate::kernels::driver::{PairOut, PairSlices, PairView, compute_pairs, record_pair};
 use crate::kernels::sweep::sort_pairs;
+use crate::physics::contact::cohesion::Cohesion;
 use crate::physics::contact::damping::Damping;
 use crate::physics::contact::normal::Normal;
 use crate::physics::contact::tangential::Tangential;
@@ -179,11 +180,11 @@ pub struct PairForces<const ENERGY: bool, const SPIN: bool> {
     released: Vec<u32>,
 }
 
-impl<N: Normal, Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN: bool> Stage<ContactModel<N, Dm, T>> for PairForces<ENERGY, SPIN> {
+impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, const ENERGY: bool, const SPIN: bool> Stage<ContactModel<N, Dm, T, C>> for PairForces<ENERGY, SPIN> {
     fn name(&self) -> String {
         "PairContacts".into()
     }
-    fn run(&mut self, w: &mut World<ContactModel<N, Dm, T>>) -> Result<(), Error> {
+    fn run(&mut self, w: &mut World<ContactModel<N, Dm, T, C>>) -> Result<(), Error> {
         let mut worst = w.max_overlap;
         let mut f = std::mem::take(&mut w.p.f);
         let mut torque = std::mem::take(&mut w.p.torque);
@@ -203,7 +204,7 @@ impl<N: Normal, Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN: bool
                 ts[j] -= o.torque[1];
             }
         };
-        let (ratio, k) = compute_pairs::<N, Dm, T, ENERGY, SPIN>(&view, list, touching, sep, released, sink);
+        let (ratio, k) = compute_pairs::<N, Dm, T, C, ENERGY, SPIN>(&view, list, touching, sep, released, sink);
         if ratio > worst.0 {
             let [i, j] = pairs.pairs()[k];
             worst = (ratio, i as usize, j as usize);
@@ -231,11 +232,11 @@ fn wall_input<T: Tangential>(lever: crate::physics::contact::LeverArm, p: &crate
 /// `output.contacts` asks, and at the other steps a flag test.
 pub struct RecordContacts<const SPIN: bool>;
 
-impl<N: Normal, Dm: Damping, T: Tangential, const SPIN: bool> Stage<ContactModel<N, Dm, T>> for RecordContacts<SPIN> {
+impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, const SPIN: bool> Stage<ContactModel<N, Dm, T, C>> for RecordContacts<SPIN> {
     fn name(&self) -> String {
         "RecordContacts".into()
     }
-    fn run(&mut self, w: &mut World<ContactModel<N, Dm, T>>) -> Result<(), Error> {
+    fn run(&mut self, w: &mut World<ContactModel<N, Dm, T, C>>) -> Result<(), Error> {
         if !w.probe.wanted {
             return Ok(());
         }
@@ -248,7 +249,7 @@ impl<N: Normal, Dm: Damping, T: Tangential, const SPIN: bool> Stage<ContactModel
         pr.walls = w.walls.iter().map(|wall| (wall.contact_surface(), wall.v)).collect();
         let view = PairView { p: &w.p, boundary: w.boundary, law: w.law, pair_table: &w.pair_table, dt: w.dt };
         for (k, &[i, j]) in w.pairs.pairs.checked().pairs().iter().enumerate() {
-            if let Some(c) = record_pair::<N, Dm, T, SPIN>(&view, (i as usize, j as usize), &w.pairs.consts[k], &w.pairs.hist[k]) {
+            if let Some(c) = record_pair::<N, Dm, T, C, SPIN>(&view, (i as usize, j as usize), &w.pairs.consts[k], &w.pairs.hist[k]) {
                 out.push(c);
             }
         }
@@ -293,11 +294,11 @@ impl<N: Normal, Dm: Damping, T: Tangential, const SPIN: bool> Stage<ContactModel
 /// Contacts of free grains with flat walls (R* = r, m* = m).
 pub struct FlatWallForces<const ENERGY: bool>;
 
-impl<N: Normal, Dm: Damping, T: Tangential, const ENERGY: bool> Stage<ContactModel<N, Dm, T>> for FlatWallForces<ENERGY> {
+impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, const ENERGY: bool> Stage<ContactModel<N, Dm, T, C>> for FlatWallForces<ENERGY> {
     fn name(&self) -> String {
         "FlatWallContacts".into()
     }
-    fn run(&mut self, w: &mut World<ContactModel<N, Dm, T>>) -> Result<(), Error> {
+    fn run(&mut self, w: &mut World<ContactModel<N, Dm, T, C>>) -> Result<(), Error> {
         let model = w.law;
         let lever = model.options.lever_arm;
         let dt = w.dt;

@@ -9,6 +9,7 @@ use nalgebra::Vector2;
 use simba::simd::{SimdBool, SimdPartialOrd, SimdValue};
 use crate::kernels::pairs::{CheckedPairs, PairConst};
 use crate::physics::boundary::Boundary;
+use crate::physics::contact::cohesion::Cohesion;
 use crate::physics::contact::damping::Damping;
 use crate::physics::contact::normal::Normal;
 use crate::physics::contact::tangential::Tangential;
@@ -56,8 +57,8 @@ fn pair_torque<R: Real>(lever: LeverArm, c: &ContactInput<R>, ft: Vector2<R>, ri
 /// (released), or nothing; tangential state `h` and (with `ENERGY`) energy memory `e`
 /// updated.
 #[inline(always)]
-pub fn pair_contact<N: Normal, Dm: Damping, T: Tangential, const ENERGY: bool>(
-    w: &PairView<'_, ContactModel<N, Dm, T>>,
+pub fn pair_contact<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, const ENERGY: bool>(
+    w: &PairView<'_, ContactModel<N, Dm, T, C>>,
     pair: [u32; 2],
     pc: &PairConst,
     h: &mut T::History<f64>,
@@ -81,7 +82,7 @@ pub fn pair_contact<N: Normal, Dm: Damping, T: Tangential, const ENERGY: bool>(
         }
         return PairOut::default();
     }
-    let (o, n, state) = one_pair::<N, Dm, T, true>(w, (i, j), d, pc, h, active);
+    let (o, n, state) = one_pair::<N, Dm, T, C, true>(w, (i, j), d, pc, h, active);
     if ENERGY {
         model.energy_step(n, w.dt, &state, e);
     }
@@ -95,8 +96,8 @@ pub fn pair_contact<N: Normal, Dm: Damping, T: Tangential, const ENERGY: bool>(
 /// (grains that do not rotate) the spins are not read and the torques not computed.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-fn four_pairs<N: Normal, Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN: bool>(
-    w: &PairView<'_, ContactModel<N, Dm, T>>,
+fn four_pairs<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, const ENERGY: bool, const SPIN: bool>(
+    w: &PairView<'_, ContactModel<N, Dm, T, C>>,
     list: PairSlices<'_, T>,
     single: Option<&PairMaterial<Lanes>>,
     ks: &[u32],
@@ -173,8 +174,8 @@ fn four_pairs<N: Normal, Dm: Damping, T: Tangential, const ENERGY: bool, const S
 /// its output, advancing its tangential state `h`, and what its energy accounting needs
 /// (the normal and the step's contact state).
 #[inline(always)]
-fn one_pair<N: Normal, Dm: Damping, T: Tangential, const SPIN: bool>(
-    w: &PairView<'_, ContactModel<N, Dm, T>>,
+fn one_pair<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, const SPIN: bool>(
+    w: &PairView<'_, ContactModel<N, Dm, T, C>>,
     (i, j): (usize, usize),
     d: Vec2,
     pc: &PairConst,
@@ -195,7 +196,7 @@ fn one_pair<N: Normal, Dm: Damping, T: Tangential, const SPIN: bool>(
 /// (positions, velocities and tangential state `h` as they are now): its record, or
 /// `None` when it does not touch. The same function of the same inputs as the stage's
 /// (`one_pair`, whose lanes give the same bits), on a copy of the state: nothing moves.
-pub fn record_pair<N: Normal, Dm: Damping, T: Tangential, const SPIN: bool>(w: &PairView<'_, ContactModel<N, Dm, T>>, (i, j): (usize, usize), pc: &PairConst, h: &T::History<f64>) -> Option<ContactRecord> {
+pub fn record_pair<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, const SPIN: bool>(w: &PairView<'_, ContactModel<N, Dm, T, C>>, (i, j): (usize, usize), pc: &PairConst, h: &T::History<f64>) -> Option<ContactRecord> {
     let p = w.p;
     let d = w.boundary.image(p.x[i] - p.x[j]);
     let (ri, rj) = (p.r[i], p.r[j]);
@@ -203,7 +204,7 @@ pub fn record_pair<N: Normal, Dm: Damping, T: Tangential, const SPIN: bool>(w: &
         return None;
     }
     let (mut h, mut active) = (*h, true);
-    let (_, n, c) = one_pair::<N, Dm, T, SPIN>(w, (i, j), d, pc, &mut h, &mut active);
+    let (_, n, c) = one_pair::<N, Dm, T, C, SPIN>(w, (i, j), d, pc, &mut h, &mut active);
     let dn = ri + rj - d.norm();
     Some(ContactRecord {
         i: i as u32,
@@ -237,8 +238,8 @@ pub struct PairSlices<'a, T: Tangential> {
 /// them for the ledger. Returns the largest overlap over the smaller radius of the
 /// touching pairs and the index (in the part) of the first pair that has it,
 /// `(0, usize::MAX)` if none touches.
-pub fn compute_pairs<N: Normal, Dm: Damping, T: Tangential, const ENERGY: bool, const SPIN: bool>(
-    w: &PairView<'_, ContactModel<N, Dm, T>>,
+pub fn compute_pairs<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, const ENERGY: bool, const SPIN: bool>(
+    w: &PairView<'_, ContactModel<N, Dm, T, C>>,
     list: PairSlices<'_, T>,
     touching: &[u32],
     sep: &[Vec2],
@@ -252,12 +253,12 @@ pub fn compute_pairs<N: Normal, Dm: Damping, T: Tangential, const ENERGY: bool, 
     let PairSlices { pairs, consts, hist, energy, active } = list;
     for (ks, ds) in touching[..quads].chunks_exact(LANES).zip(sep.chunks_exact(LANES)) {
         let slices = PairSlices::<T> { pairs, consts, hist: &mut *hist, energy: &mut *energy, active: &mut *active };
-        four_pairs::<N, Dm, T, ENERGY, SPIN>(w, slices, single.as_ref(), ks, ds, &mut sink, &mut best);
+        four_pairs::<N, Dm, T, C, ENERGY, SPIN>(w, slices, single.as_ref(), ks, ds, &mut sink, &mut best);
     }
     for (m, &k) in touching.iter().enumerate().skip(quads) {
         let k = k as usize;
         let [i, j] = pairs.pairs()[k].map(|g| g as usize);
-        let (o, n, state) = one_pair::<N, Dm, T, SPIN>(w, (i, j), sep[m], &consts[k], &mut hist[k], &mut active[k]);
+        let (o, n, state) = one_pair::<N, Dm, T, C, SPIN>(w, (i, j), sep[m], &consts[k], &mut hist[k], &mut active[k]);
         if o.ratio > best.0 {
             best = (o.ratio, k);
         }
@@ -270,7 +271,7 @@ pub fn compute_pairs<N: Normal, Dm: Damping, T: Tangential, const ENERGY: bool, 
     for &k in released {
         let k = k as usize;
         let e = if ENERGY { &mut energy[k] } else { &mut none };
-        pair_contact::<N, Dm, T, ENERGY>(w, pairs.pairs()[k], &consts[k], &mut hist[k], e, &mut active[k]);
+        pair_contact::<N, Dm, T, C, ENERGY>(w, pairs.pairs()[k], &consts[k], &mut hist[k], e, &mut active[k]);
     }
     best
 }

@@ -37,6 +37,17 @@ pub struct Material {
     /// Coulomb friction coefficient mu, >= 0. Default 0.5.
     #[serde(default = "default_mu")]
     pub friction: f64,
+    /// Work of adhesion w (the energy per unit area it takes to part two surfaces in
+    /// contact, twice the surface energy of a like pair), J/m^2, >= 0. Default 0: no
+    /// cohesion. Above 0 the contact law adds DMT cohesion: a constant attraction
+    /// `2 pi w R*` while the grains overlap ([`crate::physics::contact::cohesion`]). A
+    /// pair takes the geometric mean `sqrt(w1 w2)`. Left out of written scenes when 0.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub work_of_adhesion: f64,
+}
+
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
 }
 
 fn default_name() -> String {
@@ -67,6 +78,7 @@ impl Default for Material {
             density: default_rho(),
             restitution: default_e_rest(),
             friction: default_mu(),
+            work_of_adhesion: 0.0,
         }
     }
 }
@@ -84,6 +96,8 @@ impl Material {
         check(r > 0.0 && r <= 1.0, at, "restitution", r, "(0, 1]")?;
         let mu = self.friction;
         check(mu.is_finite() && mu >= 0.0, at, "friction", mu, ">= 0")?;
+        let w = self.work_of_adhesion;
+        check(w.is_finite() && w >= 0.0, at, "work_of_adhesion", w, ">= 0 J/m^2")?;
         Ok(())
     }
 
@@ -117,6 +131,9 @@ pub struct PairMaterial<R = f64> {
     pub viscous_n: R,
     /// `-2 sqrt(5/6) beta sqrt(8 G*)`, Pa^1/2: `gt = viscous_t sqrt(m*) (R* dn)^(1/4)`.
     pub viscous_t: R,
+    /// `2 pi w` with w the pair's work of adhesion, N/m: the DMT pull-off force is
+    /// `pulloff R*` ([`crate::physics::contact::cohesion`]).
+    pub pulloff: R,
 }
 
 impl PairMaterial<crate::physics::lanes::Lanes> {
@@ -132,6 +149,7 @@ impl PairMaterial<crate::physics::lanes::Lanes> {
             friction: gather(|l| pm[l].friction),
             viscous_n: gather(|l| pm[l].viscous_n),
             viscous_t: gather(|l| pm[l].viscous_t),
+            pulloff: gather(|l| pm[l].pulloff),
         }
     }
 }
@@ -145,7 +163,8 @@ impl PairMaterial {
         let beta = beta(restitution);
         let c = -2.0 * SQRT_FIVE_SIXTHS * beta;
         let (viscous_n, viscous_t) = (c * (2.0 * e_star).sqrt(), c * (8.0 * g_star).sqrt());
-        PairMaterial { e_star, g_star, restitution, beta, friction: a.friction.min(b.friction), viscous_n, viscous_t }
+        let pulloff = 2.0 * std::f64::consts::PI * (a.work_of_adhesion * b.work_of_adhesion).sqrt();
+        PairMaterial { e_star, g_star, restitution, beta, friction: a.friction.min(b.friction), viscous_n, viscous_t, pulloff }
     }
 }
 

@@ -165,6 +165,16 @@ impl Scene {
         }
         let tsuji = self.model.damping == DampingSpec::Tsuji;
         check(!(tsuji && self.model.tangential == TangentialSpec::IncrementalForce), "model", "damping", "tsuji", &format!("\"restitution\" with model.tangential = incremental_force (compiled: {})", crate::physics::contact::model::COMPILED))?;
+        // DMT cohesion is compiled with the restitution damping, frictionless or with the
+        // total displacement, and without the clamp (which would remove the attraction).
+        if let Some(k) = self.materials.iter().position(|m| m.work_of_adhesion > 0.0) {
+            let w = self.materials[k].work_of_adhesion;
+            let at = format!("materials[{k}]");
+            let compiled = crate::physics::contact::model::COMPILED;
+            check(self.model.tangential != TangentialSpec::IncrementalForce, &at, "work_of_adhesion", w, &format!("0 with model.tangential = incremental_force (compiled: {compiled})"))?;
+            check(!tsuji, &at, "work_of_adhesion", w, &format!("0 with model.damping = tsuji (compiled: {compiled})"))?;
+            check(!self.model.limit_force, &at, "work_of_adhesion", w, "0 with model.limit_force = true (the clamp Fn >= 0 would remove the attraction; LAMMPS refuses limit_damping with dmt too)")?;
+        }
         if let Some(c) = self.model.general_damping {
             check(finite_pos(c), "model", "general_damping", c, "> 0 1/s (omit it for none)")?;
         }

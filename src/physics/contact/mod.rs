@@ -1,6 +1,7 @@
 //! Per-contact physics: the normal laws (Hertz, the linear spring), damping, tangential formulations, and
 //! their named combinations.
 
+pub mod cohesion;
 pub mod damping;
 pub mod model;
 pub mod normal;

@@ -1,6 +1,6 @@
-//! A contact model: a normal law (Hertz or the linear spring), a damping form and a
-//! tangential formulation, composed at compile time. Each named combination is one
-//! monomorphized kernel.
+//! A contact model: a normal law (Hertz or the linear spring), a damping form, a
+//! tangential formulation and a cohesion model, composed at compile time. Each named
+//! combination is one monomorphized kernel.
 
 use std::marker::PhantomData;
 
@@ -9,6 +9,7 @@ use serde::{Deserialize, Serialize};
 
 use nalgebra::Vector2;
 
+use super::cohesion::{Cohesion, Dmt, NoCohesion};
 use super::damping::{Damping, LinearRestitution, TsujiFit, Undamped, Viscoelastic};
 use super::normal::{Hertz, Hooke, Normal};
 use super::tangential::{Frictionless, IncrementalForce, Tangential, TangentialForce, TangentialInput, TotalDisplacement};
@@ -226,6 +227,7 @@ impl EnergyMemory<crate::physics::lanes::Lanes> {
 pub trait ContactLaw: Copy + Send + Sync + 'static {
     type Damp: Damping;
     type Tang: Tangential;
+    type Coh: Cohesion;
     fn options(&self) -> ModelOptions;
     /// The elastic energies, normal and tangential (J), a touching contact of materials
     /// `pm`, reduced radius `r_star` (m) and square root of the reduced mass
@@ -238,10 +240,11 @@ pub trait ContactLaw: Copy + Send + Sync + 'static {
     fn describe(&self) -> String {
         let o = self.options();
         format!(
-            "Contacts<{}, {}, {}{}{}>",
+            "Contacts<{}, {}, {}{}{}{}>",
             self.normal_label(),
             Self::Damp::NAME,
             Self::Tang::NAME,
+            if Self::Coh::ON { format!(", {}", Self::Coh::NAME) } else { String::new() },
             if o.limit_force { ", clamp Fn>=0" } else { "" },
             match (Self::Tang::FRICTION, o.lever_arm) {
                 (true, LeverArm::RadiusMinusHalfOverlap) => ", arm r-dn/2",
@@ -252,17 +255,17 @@ pub trait ContactLaw: Copy + Send + Sync + 'static {
     }
 }
 
-/// A contact model, composed from a normal law, a damping form and a tangential
-/// formulation.
+/// A contact model, composed from a normal law, a damping form, a tangential
+/// formulation and a cohesion model (none unless a scene's materials ask for it).
 #[derive(Clone, Copy, Debug)]
-pub struct ContactModel<N: Normal, Dm: Damping, T: Tangential> {
+pub struct ContactModel<N: Normal, Dm: Damping, T: Tangential, C: Cohesion = NoCohesion> {
     pub options: ModelOptions,
     /// The normal law and its parameters (nothing for Hertz).
     pub normal: N,
-    _p: PhantomData<(Dm, T)>,
+    _p: PhantomData<(Dm, T, C)>,
 }
 
-impl<N: Normal, Dm: Damping, T: Tangential> ContactModel<N, Dm, T> {
+impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion> ContactModel<N, Dm, T, C> {
     pub fn new(options: ModelOptions, normal: N) -> Self {
         ContactModel { options, normal, _p: PhantomData }
     }
@@ -276,11 +279,18 @@ impl<N: Normal, Dm: Damping, T: Tangential> ContactModel<N, Dm, T> {
         let (gn, gt) = Dm::coefficients(pm, c.sqrt_m_star, &st);
         let vc = c.contact_velocity();
         let vn = vc.dot(&c.n);
-        let elastic_n = st.kn * c.dn;
+        let mut elastic_n = st.kn * c.dn;
+        // DMT: the pull-off force F0 = 2 pi w R* attracts while the bodies overlap.
+        let pulloff = if C::ON { pm.pulloff * c.r_star } else { R::zero() };
+        if C::ON {
+            elastic_n -= pulloff;
+        }
         let mut fnorm = elastic_n - gn * vn;
         if self.options.limit_force {
             fnorm = pick(fnorm.simd_lt(R::zero()), R::zero(), fnorm);
         }
+        // The Coulomb cap: mu |Fn|, with cohesion mu |Fn + 2 F0| (LAMMPS' Fncrit).
+        let cap_force = if C::ON { fnorm + k::<R>(2.0) * pulloff } else { fnorm };
         let mut force = c.n * fnorm;
         let mut tf = TangentialForce::default();
         if T::FRICTION {
@@ -288,7 +298,7 @@ impl<N: Normal, Dm: Damping, T: Tangential> ContactModel<N, Dm, T> {
             if self.options.lever_arm == LeverArm::Yade {
                 vt += (c.v_rel - c.n * c.v_rel.dot(&c.n)) * (c.tangential_scale - R::one());
             }
-            let inp = TangentialInput { n: c.n, vt, kt: st.kt, gt, cap: pm.friction * fnorm.simd_abs(), dt: c.dt };
+            let inp = TangentialInput { n: c.n, vt, kt: st.kt, gt, cap: pm.friction * cap_force.simd_abs(), dt: c.dt };
             tf = T::force(h, &inp);
         }
         force += tf.elastic + tf.damping;
@@ -310,7 +320,8 @@ impl<N: Normal, Dm: Damping, T: Tangential> ContactModel<N, Dm, T> {
         if ENERGY {
             self.energy_step(c.n, c.dt, &s, &mut h.energy);
             ledger.add(&std::mem::take(&mut h.energy.sums));
-            let (un, ut) = Self::elastic(s.kn, s.kt, c.dn, s.tangential.elastic);
+            let pulloff = if C::ON { pm.pulloff * c.r_star } else { 0.0 };
+            let (un, ut) = Self::elastic(s.kn, s.kt, pulloff, c.dn, s.tangential.elastic);
             ledger.elastic_normal += un;
             ledger.elastic_tangential += ut;
         }
@@ -339,11 +350,14 @@ impl<N: Normal, Dm: Damping, T: Tangential> ContactModel<N, Dm, T> {
     }
 
     /// The elastic energies, normal and tangential (J), a touching contact of stiffnesses
-    /// `kn`, `kt` (N/m) stores at overlap `dn` (m) with elastic tangential force `fte` (N).
+    /// `kn`, `kt` (N/m) and pull-off force `pulloff` (N; 0 without cohesion) stores at
+    /// overlap `dn` (m) with elastic tangential force `fte` (N). Cohesion's potential is
+    /// `-F0 dn`.
     #[inline(always)]
-    fn elastic(kn: f64, kt: f64, dn: f64, fte: Vec2) -> (f64, f64) {
+    fn elastic(kn: f64, kt: f64, pulloff: f64, dn: f64, fte: Vec2) -> (f64, f64) {
         let ut = if T::FRICTION && kt > 0.0 { 0.5 * fte.norm_squared() / kt } else { 0.0 };
-        (N::energy(kn, dn), ut)
+        let un = N::energy(kn, dn);
+        (if C::ON { un - pulloff * dn } else { un }, ut)
     }
 
     /// A contact that was touching at the previous step and is not any more: close its
@@ -367,16 +381,17 @@ impl<N: Normal, Dm: Damping, T: Tangential> ContactModel<N, Dm, T> {
     }
 }
 
-impl<N: Normal, Dm: Damping, T: Tangential> ContactLaw for ContactModel<N, Dm, T> {
+impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion> ContactLaw for ContactModel<N, Dm, T, C> {
     type Damp = Dm;
     type Tang = T;
+    type Coh = C;
     fn options(&self) -> ModelOptions {
         self.options
     }
     #[inline]
     fn stored_energy(&self, pm: &PairMaterial, r_star: f64, sqrt_m_star: f64, dn: f64, fte: Vec2) -> (f64, f64) {
         let st = self.normal.stiffness(pm, r_star, sqrt_m_star, dn);
-        Self::elastic(st.kn, st.kt, dn, fte)
+        Self::elastic(st.kn, st.kt, pm.pulloff * r_star, dn, fte)
     }
     fn normal_label(&self) -> String {
         self.normal.label()
@@ -410,5 +425,13 @@ pub type HertzTsujiHistory = ContactModel<Hertz, TsujiFit, TotalDisplacement>;
 pub type HookeTsujiFrictionless = ContactModel<Hooke, TsujiFit, Frictionless>;
 pub type HookeTsujiHistory = ContactModel<Hooke, TsujiFit, TotalDisplacement>;
 
+/// DMT cohesion (`materials[].work_of_adhesion` > 0) with either normal law and its
+/// restitution damping (which is 0 at e = 1), frictionless or with the total-displacement
+/// history: LAMMPS `pair granular dmt` for Hertz.
+pub type HertzDmtFrictionless = ContactModel<Hertz, Viscoelastic, Frictionless, Dmt>;
+pub type HertzDmtHistory = ContactModel<Hertz, Viscoelastic, TotalDisplacement, Dmt>;
+pub type HookeDmtFrictionless = ContactModel<Hooke, LinearRestitution, Frictionless, Dmt>;
+pub type HookeDmtHistory = ContactModel<Hooke, LinearRestitution, TotalDisplacement, Dmt>;
+
 /// The names of the compiled combinations, for a refusal.
-pub const COMPILED: &str = "normal hertz or hooke (hooke_stiffness), each with damping (beta(e); the linear spring's constant-restitution form) or none (every e = 1), and tangential total_displacement, incremental_force or frictionless; damping tsuji with either normal law, total_displacement or frictionless";
+pub const COMPILED: &str = "normal hertz or hooke (hooke_stiffness), each with damping (beta(e); the linear spring's constant-restitution form) or none (every e = 1), and tangential total_displacement, incremental_force or frictionless; damping tsuji with either normal law, total_displacement or frictionless; cohesion (work_of_adhesion > 0) with either normal law, the restitution damping, total_displacement or frictionless, without limit_force";

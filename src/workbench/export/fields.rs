@@ -186,6 +186,16 @@ pub const FIELDS: &[Field] = &[
     )
     .in_lammps(written("each pair of types' `tangential ... MU`, the pair's smaller mu (0 when frictionless)")),
     each(
+        "materials[].work_of_adhesion",
+        refused("above 0 (DMT cohesion; 0, no cohesion, is what the deck computes): LIGGGHTS 3.8's cohesion models (sjkr, sjkr2) are other laws"),
+        refused("above 0 (DMT cohesion; 0, no cohesion, is what the deck computes): YADE 2023's Mindlin law has no DMT attraction"),
+    )
+    .in_lammps(
+        written("each pair of types' normal model: above 0 `dmt 2E* D 0 GAMMA` with GAMMA = w/2 (LAMMPS' 4 pi GAMMA R* is grainlab's 2 pi w R*, w the pair's geometric mean; Poisson 0 makes LAMMPS' 4/3 E/(2(1 - nu^2)) between grains and 4/3 E/(2(1 - nu)) on a wall both 4/3 E*); head-on and frictionless contacts agree to rounding")
+            .or_refused("above 0 with model.normal = hooke or hooke_stiffness: LAMMPS' dmt is Hertzian")
+            .or_differs("above 0 with friction", "LAMMPS 20220106's DMT friction cap mu |Fne + 2 F_pulloff| takes F_pulloff = 4 pi coh R* from a variable its DMT branch never sets (only JKR's does): measured on one grain sliding on a wall/gran plane and on a pair, the cap is mu |Fne + 8 pi 1e-6 R*| whatever the input cohesion, instead of grainlab's (and later LAMMPS releases') mu |Fn + 2 F0|; frictional DMT contacts differ"),
+    ),
+    each(
         "domain.periodic_x",
         written("`boundary p f f` and the box's x bounds in grains.data"),
         written("a periodic cell of length L from x_min (y and z 10x the packing: YADE cells are periodic in every direction)")

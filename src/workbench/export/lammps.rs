@@ -188,7 +188,12 @@ fn words(scene: &Scene, pm: &PairMaterial, kns: &[f64], what: &str) -> Result<St
     // both damping forces are then 0 in grainlab, and X times LAMMPS' 0 is 0 whatever X.
     let ratio = if ratio.is_finite() { ratio } else { 0.0 };
     let limit = if model.limit_force { " limit_damping" } else { "" };
-    Ok(format!("{} {} {} tangential {tangential} {} {} {} damping {damping}{limit}", normal.0, f(normal.1), f(d), f(kt), f(ratio), f(mu)))
+    // DMT cohesion (Hertz only; prepare refused the spring): `dmt E D NU GAMMA`, from
+    // which LAMMPS takes 4/3 E/(2(1 - NU^2)) between grains and 4/3 E/(2(1 - NU)) on a
+    // wall: with NU = 0 and E = 2 E* both are KN; its attraction 4 pi GAMMA R* is
+    // grainlab's 2 pi w R* with GAMMA = w/2.
+    let normal = if pm.pulloff > 0.0 { format!("dmt {} {} 0 {}", f(2.0 * pm.e_star), f(d), f(pm.pulloff / (4.0 * std::f64::consts::PI))) } else { format!("{} {} {}", normal.0, f(normal.1), f(d)) };
+    Ok(format!("{normal} tangential {tangential} {} {} {} damping {damping}{limit}", f(kt), f(ratio), f(mu)))
 }
 
 /// `pair_style granular` and a `pair_coeff` for every pair of atom types.

@@ -63,6 +63,10 @@ pub(crate) fn deck(scene: &Scene, ex: &Exported, code: Code) -> Result<String, E
         if model.tangential == TangentialSpec::IncrementalForce || (frictional && (pairs || damped)) {
             let _ = writeln!(w, "{}", differs_line(code, "model.tangential", name_of(&model.tangential)));
         }
+        // LAMMPS 20220106's DMT friction cap (docs/fidelity.md).
+        if frictional && let Some((k, m)) = mats.iter().enumerate().find(|(_, m)| m.work_of_adhesion > 0.0) {
+            let _ = writeln!(w, "{}", differs_line(code, &format!("materials[{k}].work_of_adhesion"), m.work_of_adhesion));
+        }
     } else {
         if model.lever_arm != LeverArm::RadiusMinusHalfOverlap && frictional {
             let _ = writeln!(w, "{}", differs_line(code, "model.lever_arm", name_of(&model.lever_arm)));
