@@ -103,6 +103,25 @@ fig.tight_layout()
 fig.savefig(os.path.join(OUT, "restitution.png"), dpi=110)
 plt.close(fig)
 
+# Plot 2b: DMT cohesion, the realised restitution against the impact speed.
+fig, ax = plt.subplots(figsize=(6, 4))
+for e, speeds, color in [(0.5, [0.012, 0.02, 0.1], "C0"), (0.9, [0.003, 0.01, 0.1], "C2")]:
+    cases = [f"dmt/head-on-e{e}-v{v}" for v in speeds]
+    if not all(expected(c, "lammps") for c in cases):
+        continue
+    eng = [float(r["engine"]) for c in cases for r in comparison if r["case"] == c and r["quantity"] == "restitution_normal"]
+    ax.plot(speeds, eng, "-", color=color, label=f"grainlab, e = {e}")
+    ax.plot(speeds, [float(expected(c, "lammps")[0]["restitution_normal"]) for c in cases], "+", color="C1", ms=10, label=f"LAMMPS `dmt`, e = {e}")
+    ax.axhline(e, ls=":", color=color, label=f"without cohesion, e = {e}")
+ax.set_xscale("log")
+ax.set_title("head-on glass beads, r = 1 mm, w = 1 J/m^2 (DMT)")
+ax.set_xlabel("impact speed (m/s)")
+ax.set_ylabel("realised e")
+ax.legend(fontsize=8)
+fig.tight_layout()
+fig.savefig(os.path.join(OUT, "dmt.png"), dpi=110)
+plt.close(fig)
+
 # Plot 3: oblique rebound spin against angle.
 A = [5, 15, 30, 45, 60, 75, 85]
 fig, axes = plt.subplots(1, 2, figsize=(10, 4))
@@ -323,6 +342,27 @@ md.append("grainlab's own Tsuji damping (`model.damping: \"tsuji\"`, docs/model.
 md.append("with the restitution as its input; the `tsuji/` cases (head-on grids under Hertz and the given")
 md.append("spring, clamp on and off, frictionless oblique impacts on a wall and a grain) agree to rounding.")
 md.append("LIGGGHTS and YADE have no Tsuji fit: their exports refuse it by name.")
+md.append("")
+md.append("DMT cohesion (`materials[].work_of_adhesion`, docs/model.md) is LAMMPS' `dmt 2E* D 0 GAMMA`")
+md.append("with GAMMA = w/2 (LAMMPS' attraction 4 pi GAMMA R* is grainlab's 2 pi w R*; Poisson 0 makes")
+md.append("its 4/3 E/(2(1 - nu^2)) between grains and 4/3 E/(2(1 - nu)) on a wall both 4/3 E*). The")
+md.append("`dmt/` cases (head-on impacts from just above the sticking speed, where the attraction takes")
+md.append("most of the rebound, to 0.1 m/s at e = 0.5 and 0.9; frictionless oblique impacts on a wall")
+md.append("and a grain) agree to rounding:")
+md.append("")
+md.append("![dmt](fidelity/dmt.png)")
+md.append("")
+md.append("Frictional DMT contacts are not compared: LAMMPS 20220106's friction cap for `dmt`,")
+md.append("mu |Fne + 2 F_pulloff| with F_pulloff = 4 pi coh R*, reads `coh` from a variable its DMT")
+md.append("branch never assigns (only the JKR branch does; later releases assign it). Measured with")
+md.append("one grain sliding on a `wall/gran` plane and on a grain, one step each: the cap is")
+md.append("mu |Fne + 8 pi 1e-6 R*| whatever the input cohesion (0 or 1 J/m^2, at two time steps and")
+md.append("speeds), not mu |Fne + 2 F0|, which is what grainlab computes (Thornton's and later LAMMPS'")
+md.append("rule); a grain hitting a wall at 0.02 m/s, e = 1, mu = 0.5, then rebounds in LAMMPS with")
+md.append("2.8 times grainlab's spin at 60 degrees and 18 times at 30 (w = 1 J/m^2), and within 6e-6")
+md.append("of it when grainlab's cap is set to mu |Fn| instead. The decks say so in a `# Differs:` line.")
+md.append("LIGGGHTS 3.8 (whose cohesion models are")
+md.append("sjkr and sjkr2) and YADE's Mindlin law have no DMT attraction: their exports refuse it.")
 md.append("")
 md.append("## Shear cell")
 md.append("")
