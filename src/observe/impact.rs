@@ -185,6 +185,16 @@ impl ImpactObserver {
         self.t_end.is_some()
     }
 
+    /// Why there is no rebound to measure, if there is none: the bodies never touched,
+    /// or they were still in contact when the run ended.
+    pub fn unfinished(&self) -> Option<&'static str> {
+        match (self.t_start, self.t_end) {
+            (_, Some(_)) => None,
+            (None, None) => Some("the bodies never touched within the run: no impact to measure"),
+            (Some(_), None) => Some("the bodies were still in contact when the run ended: stuck together (cohesion below its sticking speed) or a run too short for the contact; no rebound to measure"),
+        }
+    }
+
     fn peak(&self, f: impl Fn(&CurvePoint) -> f64) -> f64 {
         let v: Vec<f64> = self.curve.iter().map(f).collect();
         let Some((k, &m)) = v.iter().enumerate().max_by(|a, b| a.1.total_cmp(b.1)) else { return f64::NAN };

@@ -51,6 +51,10 @@ pub struct Summary {
     pub particle_steps_per_s: f64,
     pub energy: Option<EnergySummary>,
     pub impact: Option<ImpactSummary>,
+    /// Why an impact scene has no `impact`: the bodies never touched, or had not parted
+    /// when the run ended (absent otherwise).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub impact_note: Option<String>,
     /// The wall stresses' time averages: of the run, or of a protocol's last averaged
     /// stage (each stage's are in `stages`).
     pub shear: Option<ShearSummary>,
@@ -92,6 +96,9 @@ pub fn headline(s: &Summary) -> String {
     }
     if let Some(i) = &s.impact {
         parts.push(format!("e_n = {:.4}", i.restitution_normal));
+    }
+    if let Some(n) = &s.impact_note {
+        parts.push(format!("impact: {n}"));
     }
     if let Some(e) = &s.energy {
         parts.push(format!("energy residual {:.1e} of the input", e.max_residual_rel));

@@ -585,6 +585,7 @@ fn drive(scene: &Scene, mut built: Built, opts: &RunOptions, resumed: Option<(Ou
         particle_steps_per_s: p.n_free as f64 * e.steps() as f64 / wall_time.max(1e-9),
         energy: energy_on.then(|| energy_summary(st.last_row.unwrap_or_else(|| e.energy_row()), st.max_res, dt)),
         impact: st.impact.as_ref().and_then(|o| o.summary()),
+        impact_note: st.impact.as_ref().and_then(|o| o.unfinished()).map(String::from),
         shear,
         stages,
         stage_timing,
