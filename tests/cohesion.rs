@@ -191,6 +191,11 @@ fn dmt_is_refused_where_it_is_not_compiled_and_by_the_codes_without_it() {
         let e = grainlab::Scene::from_json(&t.to_json()).expect_err("not compiled").to_string();
         assert!(e.contains("materials[0].work_of_adhesion") && e.contains(what), "{e}");
     }
+    // An attraction the contacts cannot hold: it would press the grains past the
+    // watchdog's overlap (0.1 r) by itself (the fuzzer's 1e308 made the forces infinite).
+    s.materials[0].work_of_adhesion = 1e9;
+    let e = grainlab::build(&s).err().expect("refused").to_string();
+    assert!(e.contains("materials[0].work_of_adhesion = 1000000000") && e.contains("at most 2.2019e5 J/m^2"), "{e}");
     s.materials[0].work_of_adhesion = -1.0;
     let e = grainlab::Scene::from_json(&s.to_json()).expect_err("negative").to_string();
     assert!(e.contains("materials[0].work_of_adhesion") && e.contains(">= 0"), "{e}");

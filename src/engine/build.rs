@@ -340,6 +340,7 @@ pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<B
     consistency::load(scene, &p, &walls, length, depth, dt)?;
     consistency::stages(scene, &p, &walls, length, depth, dt)?;
     consistency::stable_for_every_pair(scene, &p, &walls, &time_step, friction)?;
+    consistency::cohesion(scene, &p, &walls)?;
     consistency::drag(scene, dt)?;
     consistency::impact(scene, &p, &walls, &boundary, scene.duration)?;
 
