@@ -45,6 +45,26 @@ pub struct Case {
     pub scene: Scene,
 }
 
+impl Case {
+    /// The case `name` (its scene named the same with `/` as `-`, its description the
+    /// scene's), run by `codes`; `quick` for CI's quick regeneration. No force-overlap
+    /// curve, no ensemble.
+    fn new(name: String, mut scene: Scene, codes: Vec<Code>, quick: bool) -> Case {
+        scene.name = name.replace('/', "-");
+        Case { info: CaseInfo { name, description: scene.description.clone(), codes, quick, curve: false, ensemble: None }, scene }
+    }
+    /// Also compare the force-overlap curve.
+    fn with_curve(mut self, curve: bool) -> Case {
+        self.info.curve = curve;
+        self
+    }
+    /// A member of the ensemble `group`.
+    fn in_ensemble(mut self, group: String) -> Case {
+        self.info.ensemble = Some(group);
+        self
+    }
+}
+
 fn glass(restitution: f64) -> Material {
     Material { restitution, ..Material::default() }
 }
@@ -65,11 +85,10 @@ pub fn cases() -> Vec<Case> {
                     s.model.limit_force = clamp;
                     s.model.lever_arm = LeverArm::RadiusMinusHalfOverlap;
                     let name = format!("restitution/e{}-v{}-n{}-{}", num(e), num(v), num(n), if clamp { "clamp" } else { "free" });
-                    s.name = name.replace('/', "-");
                     s.description = format!("head-on glass beads r = 1 mm, e = {e}, v = {v} m/s, dt = t_c/{n}, Fn clamp {}", if clamp { "on" } else { "off" });
                     let codes = if clamp { vec![Code::Liggghts, Code::Yade, Code::Lammps] } else { vec![Code::Liggghts, Code::Lammps] };
                     let curve = n == 500.0 && v == 1.0 && [0.1, 0.5, 0.9].contains(&e);
-                    out.push(Case { info: CaseInfo { name, description: s.description.clone(), codes, quick: v == 1.0, curve, ensemble: None }, scene: s });
+                    out.push(Case::new(name, s, codes, v == 1.0).with_curve(curve));
                 }
             }
         }
@@ -77,11 +96,10 @@ pub fn cases() -> Vec<Case> {
     for &a in &ANGLES {
         for (target, builder) in [("wall", oblique_wall as fn(f64, TangentialSpec) -> Scene), ("pair", oblique_pair)] {
             for (form, code) in [(TangentialSpec::TotalDisplacement, Code::Liggghts), (TangentialSpec::IncrementalForce, Code::Yade)] {
-                let mut s = builder(a, form);
+                let s = builder(a, form);
                 let tag = if code == Code::Liggghts { "history" } else { "incremental" };
                 let name = format!("oblique-{target}/{tag}-a{}", num(a));
-                s.name = name.replace('/', "-");
-                out.push(Case { info: CaseInfo { name, description: s.description.clone(), codes: vec![code], quick: a == 45.0, curve: false, ensemble: None }, scene: s });
+                out.push(Case::new(name, s, vec![code], a == 45.0));
             }
         }
     }
@@ -130,9 +148,8 @@ pub fn cases() -> Vec<Case> {
             }
             s.output.frames = 0;
             let name = format!("{group}/seed-{seed}");
-            s.name = name.replace('/', "-");
             s.description = format!("the shear cell with 200 grains (0.008 m periodic), packing seed {seed}, with {}'s settings: one member of {group}", code.name());
-            out.push(Case { info: CaseInfo { name, description: s.description.clone(), codes: vec![code], quick: false, curve: false, ensemble: Some(group.clone()) }, scene: s });
+            out.push(Case::new(name, s, vec![code], false).in_ensemble(group.clone()));
         }
     }
     out
@@ -154,15 +171,13 @@ fn lammps_cases(out: &mut Vec<Case>) {
         let mut s = builtin::oblique(glass(1.0), 1e-3, 1.0, a, TangentialSpec::TotalDisplacement, 200.0);
         s.model.lever_arm = LeverArm::Radius;
         let name = format!("oblique-wall/lammps-a{}", num(a));
-        s.name = name.replace('/', "-");
         s.description = format!("glass bead on a flat glass wall at 1 m/s, {a} deg from the normal, e = 1, mu = 0.5, lever arm r (LAMMPS' wall/gran), t_c/200");
-        out.push(Case { info: CaseInfo { name, description: s.description.clone(), codes: vec![Code::Lammps], quick: a == 45.0, curve: false, ensemble: None }, scene: s });
+        out.push(Case::new(name, s, vec![Code::Lammps], a == 45.0));
         let mut s = builtin::oblique_pair(glass(0.9), 1e-3, 1.0, a, TangentialSpec::Frictionless, 200.0);
         s.model.lever_arm = LeverArm::Radius;
         let name = format!("oblique-pair/lammps-frictionless-a{}", num(a));
-        s.name = name.replace('/', "-");
         s.description = format!("glass bead on a resting one at 1 m/s, {a} deg from the line of centres, e = 0.9, frictionless, t_c/200");
-        out.push(Case { info: CaseInfo { name, description: s.description.clone(), codes: vec![Code::Lammps], quick: a == 45.0, curve: false, ensemble: None }, scene: s });
+        out.push(Case::new(name, s, vec![Code::Lammps], a == 45.0));
     }
     tsuji_cases(out);
     dmt_cases(out);
@@ -184,9 +199,8 @@ fn dmt_cases(out: &mut Vec<Case>) {
     use crate::scene::NormalLaw;
     let sticky = |e: f64| Material { work_of_adhesion: DMT_WORK_OF_ADHESION, ..glass(e) };
     let mut push = |name: String, mut s: Scene, description: String, quick: bool| {
-        s.name = name.replace('/', "-");
         s.description = description;
-        out.push(Case { info: CaseInfo { name, description: s.description.clone(), codes: vec![Code::Lammps], quick, curve: false, ensemble: None }, scene: s });
+        out.push(Case::new(name, s, vec![Code::Lammps], quick));
     };
     for (e, speeds) in [(0.5, [0.012, 0.02, 0.1]), (0.9, [0.003, 0.01, 0.1])] {
         for v in speeds {
@@ -222,9 +236,8 @@ fn tsuji_cases(out: &mut Vec<Case>) {
                     s.model.damping = DampingSpec::Tsuji;
                     s.model.limit_force = clamp;
                     let name = format!("tsuji/{tag}-e{}-n{}-{}", num(e), num(n), if clamp { "clamp" } else { "free" });
-                    s.name = name.replace('/', "-");
                     s.description = format!("head-on glass beads r = 1 mm, {tag}, Tsuji damping (LAMMPS' fit) of e = {e}, v = 1 m/s, dt = t_c/{n}, Fn clamp {}", if clamp { "on" } else { "off" });
-                    out.push(Case { info: CaseInfo { name, description: s.description.clone(), codes: vec![Code::Lammps], quick: n == 500.0, curve: false, ensemble: None }, scene: s });
+                    out.push(Case::new(name, s, vec![Code::Lammps], n == 500.0));
                 }
             }
         }
@@ -234,9 +247,8 @@ fn tsuji_cases(out: &mut Vec<Case>) {
         let mut s = builder(glass(0.5), 1e-3, 1.0, 45.0, TangentialSpec::Frictionless, 200.0);
         s.model.damping = DampingSpec::Tsuji;
         let name = format!("tsuji/{target}-frictionless-a45");
-        s.name = name.replace('/', "-");
         s.description = format!("glass bead on {what} at 1 m/s, 45 deg, frictionless, Tsuji damping of e = 0.5, t_c/200");
-        out.push(Case { info: CaseInfo { name, description: s.description.clone(), codes: vec![Code::Lammps], quick: true, curve: false, ensemble: None }, scene: s });
+        out.push(Case::new(name, s, vec![Code::Lammps], true));
     }
 }
 
@@ -256,10 +268,9 @@ fn linear_spring_cases(out: &mut Vec<Case>) {
                     s.model.limit_force = clamp;
                     s.model.lever_arm = LeverArm::RadiusMinusHalfOverlap;
                     let name = format!("hooke-restitution/{tag}-e{}-n{}-{}", num(e), num(n), if clamp { "clamp" } else { "free" });
-                    s.name = name.replace('/', "-");
                     s.description = format!("head-on glass beads r = 1 mm on the linear spring ({tag} stiffness), e = {e}, v = 1 m/s, dt = t_c/{n}, Fn clamp {}", if clamp { "on" } else { "off" });
                     let curve = n == 500.0 && e == 0.5 && !clamp;
-                    out.push(Case { info: CaseInfo { name, description: s.description.clone(), codes: vec![Code::Liggghts, Code::Lammps], quick: true, curve, ensemble: None }, scene: s });
+                    out.push(Case::new(name, s, vec![Code::Liggghts, Code::Lammps], true).with_curve(curve));
                 }
             }
         }
@@ -269,9 +280,8 @@ fn linear_spring_cases(out: &mut Vec<Case>) {
             let mut s = if target == "wall" { oblique_wall(a, TangentialSpec::TotalDisplacement) } else { oblique_pair(a, TangentialSpec::TotalDisplacement) };
             s.model.normal = law;
             let name = format!("hooke-oblique-{target}/history-a{}", num(a));
-            s.name = name.replace('/', "-");
             s.description = format!("{} on the linear spring ({} stiffness)", s.description, if target == "wall" { "derived" } else { "given" });
-            out.push(Case { info: CaseInfo { name, description: s.description.clone(), codes: vec![Code::Liggghts], quick: a == 45.0, curve: false, ensemble: None }, scene: s });
+            out.push(Case::new(name, s, vec![Code::Liggghts], a == 45.0));
         }
     }
     let mut s = builtin::shear();
@@ -299,17 +309,15 @@ fn chung_ooi_cases(out: &mut Vec<Case>) {
             let mut s = builtin::on_rigid_plane(al2o3.clone(), GrainShape::SphereInPlane, 2.5e-3, 3.9 * t.cos(), 3.9 * t.sin(), 0.0, 500.0, form);
             matched(&mut s, form);
             let name = format!("chung-ooi/test4-{tag}-a{}", num(a));
-            s.name = name.replace('/', "-");
             s.description = format!("Chung & Ooi test 4: Al2O3 grain (R = 2.5 mm, e = 0.98, mu = 0.092) on a rigid plane at 3.9 m/s, {a} deg from the normal, t_c/500");
-            out.push(Case { info: CaseInfo { name, description: s.description.clone(), codes: vec![code], quick: a == 45.0, curve: false, ensemble: None }, scene: s });
+            out.push(Case::new(name, s, vec![code], a == 45.0));
         }
         for ratio in [-10.0, -4.0, 3.0, 5.0, 10.0] {
             let mut s = builtin::on_rigid_plane(al.clone(), GrainShape::SphereInPlane, 0.1, 0.2, 0.0, ratio * 0.2 / 0.1, 500.0, form);
             matched(&mut s, form);
             let name = format!("chung-ooi/test6-{tag}-w{}", num(ratio));
-            s.name = name.replace('/', "-");
             s.description = format!("Chung & Ooi test 6: Al grain (R = 0.1 m, e = 0.5, mu = 0.4) on a rigid plane at vn = 0.2 m/s with spin w0 r / vn = {ratio}, t_c/500");
-            out.push(Case { info: CaseInfo { name, description: s.description.clone(), codes: vec![code], quick: ratio == 5.0, curve: false, ensemble: None }, scene: s });
+            out.push(Case::new(name, s, vec![code], ratio == 5.0));
         }
     }
 }
