@@ -4,7 +4,7 @@
 //! [`crate::engine::simulation`].
 
 use crate::engine::neighbor::Neighbours;
-use crate::error::Error;
+use crate::error::{Error, Shown};
 use crate::kernels::pairs::PairList;
 use crate::physics::boundary::Boundary;
 use crate::physics::contact::tangential::Tangential;
@@ -149,7 +149,14 @@ impl<L: ContactLaw> World<L> {
         let p = &self.p;
         let bad = |i: usize| !(p.x[i].x.is_finite() && p.x[i].y.is_finite() && p.v[i].norm_squared().is_finite() && p.omega[i].is_finite() && (p.omega[i] * p.omega[i]).is_finite());
         if let Some(i) = (0..p.n_free).find(|&i| bad(i)) {
-            return Err(self.unstable_at(format!("grain {i} has a non-finite position, velocity or spin (x = {:?}, v = {:?}, omega = {})", p.x[i], p.v[i], p.omega[i]), Some(i)));
+            // Each quantity by value if it is finite, else in words: a diagnosis holds no
+            // number that is not one.
+            let say = |ok: bool, v: String| if ok { v } else { "not finite".to_string() };
+            let (x, v, w) = (p.x[i], p.v[i], p.omega[i]);
+            let x = say(x.x.is_finite() && x.y.is_finite(), format!("[{}, {}]", x.x.shown(), x.y.shown()));
+            let v = say(v.norm_squared().is_finite(), format!("[{}, {}]", v.x.shown(), v.y.shown()));
+            let w = say(w.is_finite() && (w * w).is_finite(), w.shown());
+            return Err(self.unstable_at(format!("grain {i} has a non-finite position, velocity or spin (x = {x} m, v = {v} m/s, omega = {w} rad/s)"), Some(i)));
         }
         if let Some(w) = self.walls.iter().find(|w| !(w.y.is_finite() && w.v.norm_squared().is_finite() && w.force.norm_squared().is_finite())) {
             return Err(self.unstable_at(format!("the {} wall's position, velocity or force is not finite", w.name), None));
