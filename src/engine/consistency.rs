@@ -256,12 +256,6 @@ pub fn motion(p: &Particles, walls: &[Wall], gravity: Vec2, names: &GrainNames, 
     bound.gravity("gravity".into(), gravity)
 }
 
-/// The time step must be stable for every pair of materials the scene's grains and walls
-/// use, not only for the smallest grain's own material (which sets dt): each pair of
-/// free grains' materials at the smallest radius, each free grain against a rough wall's
-/// glued grain, and against each flat wall, every grain of its own material's mass.
-/// Without `time_step.allow_unstable`, dt above the stiffest pair's limit is refused.
-/// `friction`: a tangential force can arise ([`crate::engine::effects::Effects::friction`]).
 /// DMT cohesion that the contacts can hold: for every pair of materials that can touch
 /// with a work of adhesion, the attraction 2 pi w R* of the largest free grain (R* = r,
 /// as on a flat wall: the largest attraction) must not press it past the watchdog's
@@ -271,47 +265,41 @@ pub fn motion(p: &Particles, walls: &[Wall], gravity: Vec2, names: &GrainNames, 
 /// enough w would make the forces infinite).
 pub fn cohesion(scene: &Scene, p: &Particles, walls: &[Wall]) -> Result<(), Error> {
     let mats = &scene.materials;
-    if !mats.iter().any(|m| m.work_of_adhesion > 0.0) || p.n_free == 0 {
+    if scene.adhesive_material().is_none() || p.n_free == 0 {
         return Ok(());
     }
-    let used = |grains: std::ops::Range<usize>| {
-        let mut m: Vec<usize> = p.material[grains].iter().map(|&m| m as usize).collect();
-        m.sort_unstable();
-        m.dedup();
-        m
-    };
-    let free = used(0..p.n_free);
-    let mut other = used(p.n_free..p.len());
-    other.extend(walls.iter().filter(|w| w.is_flat()).map(|w| w.material));
     let r_min = p.r[..p.n_free].iter().cloned().fold(f64::INFINITY, f64::min);
     let r_max = p.r[..p.n_free].iter().cloned().fold(0.0, f64::max);
     let dn = MAX_START_OVERLAP * r_min;
-    for (ia, &a) in free.iter().enumerate() {
-        for &b in free[ia..].iter().chain(other.iter()) {
-            let pm = PairMaterial::mix(&mats[a], &mats[b]);
-            if pm.pulloff == 0.0 {
-                continue;
-            }
-            let m_star = 0.5 * scene.grain_shape.mass(r_max, mats[a].density);
-            let holds = scene.model.normal.stiffness(&pm, r_max, m_star, dn).kn * dn;
-            let pulloff = pm.pulloff * r_max;
-            if !(pulloff <= holds) {
-                let k = if mats[a].work_of_adhesion > 0.0 { a } else { b };
-                let w_max = holds / (2.0 * std::f64::consts::PI * r_max);
-                return Err(refuse(
-                    format!("materials[{k}].work_of_adhesion"),
-                    mats[k].work_of_adhesion,
-                    format!(
-                        "a pair work of adhesion sqrt(w_a w_b) of at most {w_max:.4e} J/m^2 between materials[{a}] and materials[{b}] (theirs: {:.4e}): above it the attraction 2 pi w R* on a grain of radius {r_max:e} m presses it more than {MAX_START_OVERLAP} of the smallest radius into its partner, past the watchdog's limit",
-                        pm.pulloff / (2.0 * std::f64::consts::PI)
-                    ),
-                ));
-            }
+    for (a, b) in crate::engine::effects::meeting_pairs(p, walls) {
+        let pm = PairMaterial::mix(&mats[a], &mats[b]);
+        if pm.pulloff == 0.0 {
+            continue;
+        }
+        let m_star = 0.5 * scene.grain_shape.mass(r_max, mats[a].density);
+        let holds = scene.model.normal.stiffness(&pm, r_max, m_star, dn).kn * dn;
+        if !(pm.pulloff * r_max <= holds) {
+            let k = if mats[a].work_of_adhesion > 0.0 { a } else { b };
+            let w_max = holds / (2.0 * std::f64::consts::PI * r_max);
+            return Err(refuse(
+                format!("materials[{k}].work_of_adhesion"),
+                mats[k].work_of_adhesion,
+                format!(
+                    "a pair work of adhesion sqrt(w_a w_b) of at most {w_max:.4e} J/m^2 between materials[{a}] and materials[{b}] (theirs: {:.4e}): above it the attraction 2 pi w R* on a grain of radius {r_max:e} m presses it more than {MAX_START_OVERLAP} of the smallest radius into its partner, past the watchdog's limit",
+                    pm.work_of_adhesion()
+                ),
+            ));
         }
     }
     Ok(())
 }
 
+/// The time step must be stable for every pair of materials the scene's grains and walls
+/// use, not only for the smallest grain's own material (which sets dt): each pair of
+/// free grains' materials at the smallest radius, each free grain against a rough wall's
+/// glued grain, and against each flat wall, every grain of its own material's mass.
+/// Without `time_step.allow_unstable`, dt above the stiffest pair's limit is refused.
+/// `friction`: a tangential force can arise ([`crate::engine::effects::Effects::friction`]).
 pub fn stable_for_every_pair(scene: &Scene, p: &Particles, walls: &[Wall], info: &crate::engine::timestep::TimeStepInfo, friction: bool) -> Result<(), Error> {
     use crate::engine::timestep::RefContact;
     if scene.time_step.allow_unstable {

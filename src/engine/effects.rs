@@ -49,7 +49,7 @@ pub struct Effects {
 /// Materials in the pairs of bodies that can touch: each free grain's against every free
 /// grain's, and against every other body's (a rough wall's glued grains, a flat wall),
 /// as material indices `(a, b)`.
-fn meeting_pairs(p: &Particles, walls: &[Wall]) -> Vec<(usize, usize)> {
+pub(crate) fn meeting_pairs(p: &Particles, walls: &[Wall]) -> Vec<(usize, usize)> {
     let mut free: Vec<usize> = p.material[..p.n_free].iter().map(|&m| m as usize).collect();
     free.sort_unstable();
     free.dedup();
@@ -124,7 +124,7 @@ impl Effects {
         // Cohesion: derived from the works of adhesion of the pairs that can touch.
         let sticky = pairs.iter().find(|q| mix(q).pulloff > 0.0);
         let cohesion_why = match sticky {
-            Some(&q) => format!("derived: the {} pair has work of adhesion {} J/m^2 (DMT: attraction 2 pi w R* while overlapping)", pair_name(mats, q), mix(&q).pulloff / (2.0 * std::f64::consts::PI)),
+            Some(&q) => format!("derived: the {} pair has work of adhesion {} J/m^2 (DMT: attraction 2 pi w R* while overlapping)", pair_name(mats, q), mix(&q).work_of_adhesion()),
             None => "derived: work_of_adhesion = 0 for every pair of bodies that can touch".to_string(),
         };
         let cohesion = sticky.is_some();

@@ -147,15 +147,17 @@ impl<L: ContactLaw> World<L> {
     /// finite (or whose kinetic energy overflows), or a wall whose state is not.
     pub fn check_finite(&self) -> Result<(), Error> {
         let p = &self.p;
-        let bad = |i: usize| !(p.x[i].x.is_finite() && p.x[i].y.is_finite() && p.v[i].norm_squared().is_finite() && p.omega[i].is_finite() && (p.omega[i] * p.omega[i]).is_finite());
-        if let Some(i) = (0..p.n_free).find(|&i| bad(i)) {
+        let x_ok = |i: usize| p.x[i].x.is_finite() && p.x[i].y.is_finite();
+        let v_ok = |i: usize| p.v[i].norm_squared().is_finite();
+        let w_ok = |i: usize| p.omega[i].is_finite() && (p.omega[i] * p.omega[i]).is_finite();
+        if let Some(i) = (0..p.n_free).find(|&i| !(x_ok(i) && v_ok(i) && w_ok(i))) {
             // Each quantity by value if it is finite, else in words: a diagnosis holds no
             // number that is not one.
             let say = |ok: bool, v: String| if ok { v } else { "not finite".to_string() };
             let (x, v, w) = (p.x[i], p.v[i], p.omega[i]);
-            let x = say(x.x.is_finite() && x.y.is_finite(), format!("[{}, {}]", x.x.shown(), x.y.shown()));
-            let v = say(v.norm_squared().is_finite(), format!("[{}, {}]", v.x.shown(), v.y.shown()));
-            let w = say(w.is_finite() && (w * w).is_finite(), w.shown());
+            let x = say(x_ok(i), format!("[{}, {}]", x.x.shown(), x.y.shown()));
+            let v = say(v_ok(i), format!("[{}, {}]", v.x.shown(), v.y.shown()));
+            let w = say(w_ok(i), w.shown());
             return Err(self.unstable_at(format!("grain {i} has a non-finite position, velocity or spin (x = {x} m, v = {v} m/s, omega = {w} rad/s)"), Some(i)));
         }
         if let Some(w) = self.walls.iter().find(|w| !(w.y.is_finite() && w.v.norm_squared().is_finite() && w.force.norm_squared().is_finite())) {

@@ -155,6 +155,11 @@ impl PairMaterial<crate::physics::lanes::Lanes> {
 }
 
 impl PairMaterial {
+    /// The pair's work of adhesion w, J/m^2 (from [`PairMaterial::pulloff`] = 2 pi w).
+    pub fn work_of_adhesion(&self) -> f64 {
+        self.pulloff / (2.0 * std::f64::consts::PI)
+    }
+
     pub fn mix(a: &Material, b: &Material) -> Self {
         let (e1, n1, e2, n2) = (a.youngs_modulus, a.poisson_ratio, b.youngs_modulus, b.poisson_ratio);
         let e_star = 1.0 / ((1.0 - n1 * n1) / e1 + (1.0 - n2 * n2) / e2);

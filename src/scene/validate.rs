@@ -167,8 +167,8 @@ impl Scene {
         check(!(tsuji && self.model.tangential == TangentialSpec::IncrementalForce), "model", "damping", "tsuji", &format!("\"restitution\" with model.tangential = incremental_force (compiled: {})", crate::physics::contact::model::COMPILED))?;
         // DMT cohesion is compiled with the restitution damping, frictionless or with the
         // total displacement, and without the clamp (which would remove the attraction).
-        if let Some(k) = self.materials.iter().position(|m| m.work_of_adhesion > 0.0) {
-            let w = self.materials[k].work_of_adhesion;
+        if let Some((k, m)) = self.adhesive_material() {
+            let w = m.work_of_adhesion;
             let at = format!("materials[{k}]");
             let compiled = crate::physics::contact::model::COMPILED;
             check(self.model.tangential != TangentialSpec::IncrementalForce, &at, "work_of_adhesion", w, &format!("0 with model.tangential = incremental_force (compiled: {compiled})"))?;
@@ -346,6 +346,11 @@ impl Scene {
     /// The fastest wall speed of the scene and of any of its stages, m/s.
     pub fn fastest_wall(&self) -> f64 {
         self.wall_velocities().iter().flatten().map(|v| v[0].hypot(v[1])).fold(0.0, f64::max)
+    }
+
+    /// The first material with a work of adhesion above 0 (DMT cohesion), with its index.
+    pub fn adhesive_material(&self) -> Option<(usize, &crate::physics::material::Material)> {
+        self.materials.iter().enumerate().find(|(_, m)| m.work_of_adhesion > 0.0)
     }
 
     /// The strongest gravity of the scene and of any of its stages, m/s^2.

@@ -289,7 +289,8 @@ impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion> ContactModel<N, Dm, T, 
         if self.options.limit_force {
             fnorm = pick(fnorm.simd_lt(R::zero()), R::zero(), fnorm);
         }
-        // The Coulomb cap: mu |Fn|, with cohesion mu |Fn + 2 F0| (LAMMPS' Fncrit).
+        // The Coulomb cap: mu |Fn|, with cohesion mu |Fn + 2 F0| (the rule LAMMPS means
+        // for dmt; its 20220106 release reads an unset value there, docs/fidelity.md).
         let cap_force = if C::ON { fnorm + k::<R>(2.0) * pulloff } else { fnorm };
         let mut force = c.n * fnorm;
         let mut tf = TangentialForce::default();

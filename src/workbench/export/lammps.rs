@@ -192,7 +192,7 @@ fn words(scene: &Scene, pm: &PairMaterial, kns: &[f64], what: &str) -> Result<St
     // which LAMMPS takes 4/3 E/(2(1 - NU^2)) between grains and 4/3 E/(2(1 - NU)) on a
     // wall: with NU = 0 and E = 2 E* both are KN; its attraction 4 pi GAMMA R* is
     // grainlab's 2 pi w R* with GAMMA = w/2.
-    let normal = if pm.pulloff > 0.0 { format!("dmt {} {} 0 {}", f(2.0 * pm.e_star), f(d), f(pm.pulloff / (4.0 * std::f64::consts::PI))) } else { format!("{} {} {}", normal.0, f(normal.1), f(d)) };
+    let normal = if pm.pulloff > 0.0 { format!("dmt {} {} 0 {}", f(2.0 * pm.e_star), f(d), f(pm.work_of_adhesion() / 2.0)) } else { format!("{} {} {}", normal.0, f(normal.1), f(d)) };
     Ok(format!("{normal} tangential {tangential} {} {} {} damping {damping}{limit}", f(kt), f(ratio), f(mu)))
 }
 

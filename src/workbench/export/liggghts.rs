@@ -64,7 +64,7 @@ pub(crate) fn deck(scene: &Scene, ex: &Exported, code: Code) -> Result<String, E
             let _ = writeln!(w, "{}", differs_line(code, "model.tangential", name_of(&model.tangential)));
         }
         // LAMMPS 20220106's DMT friction cap (docs/fidelity.md).
-        if frictional && let Some((k, m)) = mats.iter().enumerate().find(|(_, m)| m.work_of_adhesion > 0.0) {
+        if frictional && let Some((k, m)) = scene.adhesive_material() {
             let _ = writeln!(w, "{}", differs_line(code, &format!("materials[{k}].work_of_adhesion"), m.work_of_adhesion));
         }
     } else {

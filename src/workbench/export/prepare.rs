@@ -32,7 +32,7 @@ pub(crate) fn prepare(scene: &Scene, code: Code, limits: &crate::scene::limits::
     if scene.model.damping == crate::scene::DampingSpec::Tsuji && code != Code::Lammps {
         return Err(fields::refuse(code, "model.damping", "\"tsuji\"", ""));
     }
-    if let Some((k, m)) = scene.materials.iter().enumerate().find(|(_, m)| m.work_of_adhesion > 0.0)
+    if let Some((k, m)) = scene.adhesive_material()
         && (code != Code::Lammps || !scene.model.normal.is_hertz())
     {
         return Err(fields::refuse(code, &format!("materials[{k}].work_of_adhesion"), m.work_of_adhesion, if code == Code::Lammps { "model.normal = hooke" } else { "" }));
