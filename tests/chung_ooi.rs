@@ -25,7 +25,7 @@ use grainlab::scene::*;
 use grainlab::study::run::{RunOptions, run_scene};
 
 fn material(e: f64, nu: f64, rho: f64, restitution: f64, friction: f64) -> Material {
-    Material { name: "grain".into(), youngs_modulus: e, poisson_ratio: nu, density: rho, restitution, friction, work_of_adhesion: 0.0 }
+    Material { name: "grain".into(), youngs_modulus: e, poisson_ratio: nu, density: rho, restitution, friction, work_of_adhesion: 0.0, rolling_friction: 0.0 }
 }
 
 /// The two grain shapes, each with its kappa = m r^2 / I.

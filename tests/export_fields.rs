@@ -350,7 +350,7 @@ fn json_of(s: &Scene) -> Value {
 
 /// A second material, of restitution `e` (YADE takes one restitution for all pairs).
 fn steel(e: f64) -> grainlab::physics::material::Material {
-    grainlab::physics::material::Material { name: "steel".into(), youngs_modulus: 200e9, poisson_ratio: 0.3, density: 7800.0, restitution: e, friction: 0.3, work_of_adhesion: 0.0 }
+    grainlab::physics::material::Material { name: "steel".into(), youngs_modulus: 200e9, poisson_ratio: 0.3, density: 7800.0, restitution: e, friction: 0.3, work_of_adhesion: 0.0, rolling_friction: 0.0 }
 }
 
 fn bases(dir: &Path) -> Vec<Base> {
@@ -468,6 +468,17 @@ fn bases(dir: &Path) -> Vec<Base> {
     let mut adhesion = json_of(&s);
     adhesion["materials"][0]["work_of_adhesion"] = json!(0.0);
     out.push(Base { name: "collision-spring-adhesion", scene: adhesion, only: &["materials"], variant_of: None });
+    // Rolling resistance on the oblique impact (a grain on flat walls): EPSD2 (LIGGGHTS)
+    // and SDS (LAMMPS), with a rolling friction; the walk moves the law, its parameters
+    // and the coefficient.
+    let mut s = oblique.clone();
+    s.model.rolling = RollingSpec::Epsd2;
+    for m in &mut s.materials {
+        m.rolling_friction = 0.1;
+    }
+    out.push(focus("oblique-rolling-epsd2", &s, &["model.rolling", "materials"]));
+    s.model.rolling = RollingSpec::Sds { stiffness: 1e5, damping: 0.01 };
+    out.push(variant("oblique-rolling-sds", &s, "oblique-rolling-epsd2", "model.rolling", &["model.rolling", "materials"]));
     let mut s = collision.clone();
     s.model.normal = NormalLaw::Hooke { characteristic_velocity: 1.0 };
     out.push(variant("collision-hooke", &s, "collision", "model.normal", &["model.normal"]));

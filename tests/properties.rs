@@ -5,6 +5,7 @@ use grainlab::physics::boundary::Boundary;
 use grainlab::physics::dim::Vec2;
 use grainlab::kernels::cells::{brute_force_pairs, cell_pairs};
 use grainlab::kernels::threads::Threads;
+use grainlab::physics::contact::rolling::{NoRolling, Rolling};
 use proptest::prelude::*;
 
 fn packing() -> impl Strategy<Value = (Vec<Vec2>, Vec<f64>, usize, bool, f64)> {
@@ -64,20 +65,25 @@ fn contact() -> impl Strategy<Value = [f64; 9]> {
         .prop_map(|(dn, a, vx, vy, w, hx, hy, b, rs)| [10f64.powf(dn) * 5e-4, a, vx, vy, 1e3 * w, hx, hy, b, rs])
 }
 
-fn lanes_match_alone<N: grainlab::physics::contact::normal::Normal, D: grainlab::physics::contact::damping::Damping, T: grainlab::physics::contact::tangential::Tangential>(
+#[allow(clippy::too_many_arguments)]
+fn lanes_match_alone<N: grainlab::physics::contact::normal::Normal, D: grainlab::physics::contact::damping::Damping, T: grainlab::physics::contact::tangential::Tangential, Rr: Rolling>(
     normal: N,
+    rolling: Rr,
     cs: &[[f64; 9]; 4],
     limit_force: bool,
     lever_arm: grainlab::physics::contact::LeverArm,
     hist: impl Fn(&[f64; 9]) -> T::History<f64>,
     bits: impl Fn(&T::History<f64>) -> Vec<u64>,
+    rhist: impl Fn(&[f64; 9]) -> Rr::History<f64>,
+    rbits: impl Fn(&Rr::History<f64>) -> Vec<u64>,
 ) -> Result<(), TestCaseError> {
     use grainlab::physics::contact::{ContactInput, ContactModel, ModelOptions};
     use grainlab::physics::lanes::{Lanes, gather, gather2, lane2};
     use grainlab::physics::material::{Material, PairMaterial};
     use simba::simd::SimdValue;
-    let model = ContactModel::<N, D, T>::new(ModelOptions { limit_force, lever_arm }, normal);
-    let pm = PairMaterial::mix(&Material::default(), &Material::default());
+    type M<N, D, T, Rr> = ContactModel<N, D, T, grainlab::physics::contact::cohesion::NoCohesion, Rr>;
+    let model = M::<N, D, T, Rr>::with_rolling(ModelOptions { limit_force, lever_arm }, normal, rolling);
+    let pm = PairMaterial::mix(&Material { rolling_friction: 0.05, ..Material::default() }, &Material::default());
     let input = |c: &[f64; 9]| ContactInput {
         n: Vec2::new(c[1].cos(), c[1].sin()),
         dn: c[0],
@@ -87,9 +93,11 @@ fn lanes_match_alone<N: grainlab::physics::contact::normal::Normal, D: grainlab:
         spin: 2.5e-4 * c[4],
         dt: 5.8e-8,
         tangential_scale: 1.0 + c[0] / 5e-4,
+        roll: c[4] - c[2],
+        roll_scale: 1.0 + c[0] / 2.5e-4,
     };
     let alone: Vec<_> = cs.iter().map(|c| {
-        let mut h = hist(c);
+        let mut h = (hist(c), rhist(c));
         let s = model.force(&input(c), &pm, &mut h);
         (s, h)
     }).collect();
@@ -103,16 +111,21 @@ fn lanes_match_alone<N: grainlab::physics::contact::normal::Normal, D: grainlab:
         spin: gather(|l| one[l].spin),
         dt: Lanes::splat(5.8e-8),
         tangential_scale: gather(|l| one[l].tangential_scale),
+        roll: gather(|l| one[l].roll),
+        roll_scale: gather(|l| one[l].roll_scale),
     };
-    let hs: Vec<_> = cs.iter().map(&hist).collect();
-    let mut h = T::gather([&hs[0], &hs[1], &hs[2], &hs[3]]);
+    let hs: Vec<_> = cs.iter().map(|c| (hist(c), rhist(c))).collect();
+    let mut h = M::<N, D, T, Rr>::gather([&hs[0], &hs[1], &hs[2], &hs[3]]);
     let s = model.force(&lanes, &PairMaterial::gather([&pm; 4]), &mut h);
     for l in 0..4 {
         let f = lane2(&s.force, l);
         prop_assert_eq!(f.x.to_bits(), alone[l].0.force.x.to_bits(), "lane {} force x", l);
         prop_assert_eq!(f.y.to_bits(), alone[l].0.force.y.to_bits(), "lane {} force y", l);
         prop_assert_eq!(s.normal.extract(l).to_bits(), alone[l].0.normal.to_bits());
-        prop_assert_eq!(bits(&T::lane(&h, l)), bits(&alone[l].1), "lane {} history", l);
+        let hl = M::<N, D, T, Rr>::lane(&h, l);
+        prop_assert_eq!(bits(&hl.0), bits(&alone[l].1.0), "lane {} history", l);
+        prop_assert_eq!(s.rolling.extract(l).to_bits(), alone[l].0.rolling.to_bits(), "lane {} rolling torque", l);
+        prop_assert_eq!(rbits(&hl.1), rbits(&alone[l].1.1), "lane {} rolling history", l);
     }
     // The energy memory (previous values and sums), from a made-up previous step,
     // likewise.
@@ -120,16 +133,17 @@ fn lanes_match_alone<N: grainlab::physics::contact::normal::Normal, D: grainlab:
     use grainlab::physics::energy::EnergySums;
     let memory = |c: &[f64; 9]| EnergyMemory {
         fd_prev: c[2],
+        mr_prev: 1e-6 * c[5],
         fte_prev: Vec2::new(c[5], c[6]) * 1e3,
         ftd_prev: Vec2::new(c[3], c[4]),
-        sums: EnergySums { normal_damping: 1e-9 * c[8], tangential_damping: 1e-9 * c[7], friction: 1e-9 * c[0].abs(), tangential_model: 1e-9 * c[1] },
+        sums: EnergySums { normal_damping: 1e-9 * c[8], tangential_damping: 1e-9 * c[7], friction: 1e-9 * c[0].abs(), tangential_model: 1e-9 * c[1], rolling: 1e-9 * c[6] },
     };
     let mem_bits = |m: &EnergyMemory| {
         let s = &m.sums;
-        [m.fd_prev, m.fte_prev.x, m.fte_prev.y, m.ftd_prev.x, m.ftd_prev.y, s.normal_damping, s.tangential_damping, s.friction, s.tangential_model].map(f64::to_bits)
+        [m.fd_prev, m.mr_prev, m.fte_prev.x, m.fte_prev.y, m.ftd_prev.x, m.ftd_prev.y, s.normal_damping, s.tangential_damping, s.friction, s.tangential_model, s.rolling].map(f64::to_bits)
     };
     let mems: Vec<_> = cs.iter().map(memory).collect();
-    let mut m = EnergyMemory::gather([&mems[0], &mems[1], &mems[2], &mems[3]], true);
+    let mut m = EnergyMemory::gather([&mems[0], &mems[1], &mems[2], &mems[3]], true, true);
     model.energy_step(lanes.n, lanes.dt, &s, &mut m);
     for l in 0..4 {
         let mut alone_m = mems[l];
@@ -147,20 +161,29 @@ proptest! {
         use grainlab::physics::contact::tangential::{IncrementalForce, IncrementalState, TotalDisplacement};
         use grainlab::physics::contact::damping::{LinearRestitution, TsujiFit, Viscoelastic};
         use grainlab::physics::contact::normal::{Hertz, Hooke};
+        use grainlab::physics::contact::rolling::{Cdt, Epsd2, Sds};
         let lever = [LeverArm::Radius, LeverArm::RadiusMinusHalfOverlap, LeverArm::Yade][lever];
         let cs = [c0, c1, c2, c3];
         let v = |v: &Vec2| vec![v.x.to_bits(), v.y.to_bits()];
         let incremental = |c: &[f64; 9]| IncrementalState { force: Vec2::new(c[5], c[6]) * 1e3, n_prev: Vec2::new(c[7].cos(), c[7].sin()) };
         let incremental_bits = |h: &IncrementalState| [v(&h.force), v(&h.n_prev)].concat();
-        lanes_match_alone::<Hertz, Viscoelastic, TotalDisplacement>(Hertz, &cs, clamp, lever, |c| Vec2::new(c[5], c[6]), v)?;
-        lanes_match_alone::<Hertz, Viscoelastic, IncrementalForce>(Hertz, &cs, clamp, lever, incremental, incremental_bits)?;
+        lanes_match_alone::<Hertz, Viscoelastic, TotalDisplacement, NoRolling>(Hertz, NoRolling, &cs, clamp, lever, |c| Vec2::new(c[5], c[6]), v, |_| (), |_| vec![])?;
+        lanes_match_alone::<Hertz, Viscoelastic, IncrementalForce, NoRolling>(Hertz, NoRolling, &cs, clamp, lever, incremental, incremental_bits, |_| (), |_| vec![])?;
         // The linear spring, derived per pair (a fifth root lane by lane) and given.
         for spring in [Hooke::Derived { vc: 0.8 }, Hooke::Given { kn: 3e5, kt: 2e5 }] {
-            lanes_match_alone::<Hooke, LinearRestitution, TotalDisplacement>(spring, &cs, clamp, lever, |c| Vec2::new(c[5], c[6]), v)?;
-            lanes_match_alone::<Hooke, LinearRestitution, IncrementalForce>(spring, &cs, clamp, lever, incremental, incremental_bits)?;
-            lanes_match_alone::<Hooke, TsujiFit, TotalDisplacement>(spring, &cs, clamp, lever, |c| Vec2::new(c[5], c[6]), v)?;
+            lanes_match_alone::<Hooke, LinearRestitution, TotalDisplacement, NoRolling>(spring, NoRolling, &cs, clamp, lever, |c| Vec2::new(c[5], c[6]), v, |_| (), |_| vec![])?;
+            lanes_match_alone::<Hooke, LinearRestitution, IncrementalForce, NoRolling>(spring, NoRolling, &cs, clamp, lever, incremental, incremental_bits, |_| (), |_| vec![])?;
+            lanes_match_alone::<Hooke, TsujiFit, TotalDisplacement, NoRolling>(spring, NoRolling, &cs, clamp, lever, |c| Vec2::new(c[5], c[6]), v, |_| (), |_| vec![])?;
         }
+        // Rolling resistance: the constant torque (a sign lane by lane), the torque
+        // spring and LAMMPS' SDS, from states below and beyond their caps.
+        let torque = |c: &[f64; 9]| 1e-6 * c[6] * 1e5;
+        let roll_bits = |m: &f64| vec![m.to_bits()];
+        lanes_match_alone::<Hertz, Viscoelastic, TotalDisplacement, Cdt>(Hertz, Cdt, &cs, clamp, lever, |c| Vec2::new(c[5], c[6]), v, |_| (), |_| vec![])?;
+        lanes_match_alone::<Hertz, Viscoelastic, TotalDisplacement, Epsd2>(Hertz, Epsd2, &cs, clamp, lever, |c| Vec2::new(c[5], c[6]), v, torque, roll_bits)?;
+        lanes_match_alone::<Hertz, Viscoelastic, TotalDisplacement, Sds>(Hertz, Sds { k: 2e5, g: 0.01 }, &cs, clamp, lever, |c| Vec2::new(c[5], c[6]), v, |c| c[5], roll_bits)?;
+        lanes_match_alone::<Hooke, LinearRestitution, TotalDisplacement, Epsd2>(Hooke::Given { kn: 3e5, kt: 2e5 }, Epsd2, &cs, clamp, lever, |c| Vec2::new(c[5], c[6]), v, torque, roll_bits)?;
         // LAMMPS' Tsuji damping (its polynomial of e lane by lane).
-        lanes_match_alone::<Hertz, TsujiFit, TotalDisplacement>(Hertz, &cs, clamp, lever, |c| Vec2::new(c[5], c[6]), v)?;
+        lanes_match_alone::<Hertz, TsujiFit, TotalDisplacement, NoRolling>(Hertz, NoRolling, &cs, clamp, lever, |c| Vec2::new(c[5], c[6]), v, |_| (), |_| vec![])?;
     }
 }

@@ -13,6 +13,7 @@ use crate::error::{Error, Shown};
 use crate::kernels::pairs::PairList;
 use crate::physics::boundary::Boundary;
 use crate::physics::contact::cohesion::Cohesion;
+use crate::physics::contact::rolling::Rolling;
 use crate::physics::contact::damping::Damping;
 use crate::physics::contact::normal::{Hertz, Normal};
 use crate::physics::contact::model::*;
@@ -26,7 +27,8 @@ use crate::physics::walls::{Control, Surface, Wall};
 use crate::scene::grains::read_grain_file;
 use crate::scene::limits::{Limits, MemoryEstimate};
 use crate::scene::pack::relaxed_packing;
-use crate::scene::{Analysis, ControlSpec, DampingSpec, Grains, Scene, SurfaceSpec, TangentialSpec, TimeStepRule};
+use crate::physics::contact::rolling::Sds;
+use crate::scene::{Analysis, ControlSpec, DampingSpec, Grains, RollingSpec, Scene, SurfaceSpec, TangentialSpec, TimeStepRule};
 
 /// What was built, besides the engine.
 pub struct Built {
@@ -364,7 +366,16 @@ pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<B
     let threads = crate::kernels::threads::Threads::new(threads)?;
     let parts = Parts { p, boundary, walls, dt, skin, scene, threads, domain, context };
     let tsuji = scene.model.damping == DampingSpec::Tsuji;
+    let rolling = if effects.rolling { scene.model.rolling } else { RollingSpec::None };
     let engine: Box<dyn Engine> = match (scene.model.normal.hooke(), tangential, all_elastic) {
+        // Rolling resistance, with the restitution damping (0 when every e = 1) and the
+        // total displacement; validation refused the other combinations.
+        (None, _, _) if rolling == RollingSpec::Cdt => parts.assemble(HertzHistoryCdt::new(options, Hertz))?,
+        (None, _, _) if rolling == RollingSpec::Epsd2 => parts.assemble(HertzHistoryEpsd2::new(options, Hertz))?,
+        (Some(h), _, _) if rolling == RollingSpec::Cdt => parts.assemble(HookeHistoryCdt::new(options, h))?,
+        (Some(h), _, _) if rolling == RollingSpec::Epsd2 => parts.assemble(HookeHistoryEpsd2::new(options, h))?,
+        (None, _, _) if let RollingSpec::Sds { stiffness, damping } = rolling => parts.assemble(HertzHistorySds::with_rolling(options, Hertz, Sds { k: stiffness, g: damping }))?,
+        (Some(h), _, _) if let RollingSpec::Sds { stiffness, damping } = rolling => parts.assemble(HookeHistorySds::with_rolling(options, h, Sds { k: stiffness, g: damping }))?,
         // DMT cohesion, with the restitution damping (0 when every e = 1); validation
         // refused it with the incremental force, Tsuji's damping and the clamp.
         (None, TangentialSpec::Frictionless, _) if effects.cohesion => parts.assemble(HertzDmtFrictionless::new(options, Hertz))?,
@@ -436,12 +447,12 @@ struct Parts<'a> {
 }
 
 impl Parts<'_> {
-    fn assemble<N: Normal, Dm: Damping, T: Tangential, C: Cohesion>(self, law: ContactModel<N, Dm, T, C>) -> Result<Box<dyn Engine>, Error> {
-        if self.scene.output.energy { self.assemble_with::<N, Dm, T, C, true>(law) } else { self.assemble_with::<N, Dm, T, C, false>(law) }
+    fn assemble<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling>(self, law: ContactModel<N, Dm, T, C, Rr>) -> Result<Box<dyn Engine>, Error> {
+        if self.scene.output.energy { self.assemble_with::<N, Dm, T, C, Rr, true>(law) } else { self.assemble_with::<N, Dm, T, C, Rr, false>(law) }
     }
 
-    fn assemble_with<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, const E: bool>(self, law: ContactModel<N, Dm, T, C>) -> Result<Box<dyn Engine>, Error> {
-        type L<N, Dm, T, C> = ContactModel<N, Dm, T, C>;
+    fn assemble_with<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling, const E: bool>(self, law: ContactModel<N, Dm, T, C, Rr>) -> Result<Box<dyn Engine>, Error> {
+        type L<N, Dm, T, C, Rr> = ContactModel<N, Dm, T, C, Rr>;
         let scene = self.scene;
         let rotation = T::FRICTION && scene.model.rotation;
         let has_walls = !self.walls.is_empty();
@@ -478,9 +489,9 @@ impl Parts<'_> {
         };
         // The force stages, shared by the step and by the set-up at t = 0.
         let threads = self.threads.clone();
-        type Stages<N, Dm, T, C> = Vec<Box<dyn Stage<L<N, Dm, T, C>>>>;
-        let forces = || -> Result<Stages<N, Dm, T, C>, Error> {
-            let mut s: Stages<N, Dm, T, C> = vec![Box::new(UpdateNeighbours), Box::new(ClearForces)];
+        type Stages<N, Dm, T, C, Rr> = Vec<Box<dyn Stage<L<N, Dm, T, C, Rr>>>>;
+        let forces = || -> Result<Stages<N, Dm, T, C, Rr>, Error> {
+            let mut s: Stages<N, Dm, T, C, Rr> = vec![Box::new(UpdateNeighbours), Box::new(ClearForces)];
             if pulled {
                 s.push(Box::new(Gravity::<E>));
             }
@@ -490,13 +501,13 @@ impl Parts<'_> {
             if scene.output.contacts {
                 s.push(if rotation { Box::new(RecordContacts::<true>) } else { Box::new(RecordContacts::<false>) });
             }
-            s.push(if rotation { pair_stage::<N, Dm, T, C, E, true>(&threads) } else { pair_stage::<N, Dm, T, C, E, false>(&threads) });
+            s.push(if rotation { pair_stage::<N, Dm, T, C, Rr, E, true>(&threads) } else { pair_stage::<N, Dm, T, C, Rr, E, false>(&threads) });
             if has_flat {
                 s.push(Box::new(FlatWallForces::<E>));
             }
             Ok(s)
         };
-        let mut stages: Stages<N, Dm, T, C> = Vec::new();
+        let mut stages: Stages<N, Dm, T, C, Rr> = Vec::new();
         // The walls first: their grains follow them in the drift.
         if has_walls {
             stages.push(Box::new(MoveWalls));
@@ -526,7 +537,7 @@ impl Parts<'_> {
 
 /// The grain-grain contact stage: serial, or on the run's pool of threads; with `SPIN` when
 /// the grains rotate (without, the kernel neither reads spins nor computes torques).
-fn pair_stage<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, const E: bool, const SPIN: bool>(threads: &crate::kernels::threads::Threads) -> Box<dyn Stage<ContactModel<N, Dm, T, C>>> {
+fn pair_stage<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling, const E: bool, const SPIN: bool>(threads: &crate::kernels::threads::Threads) -> Box<dyn Stage<ContactModel<N, Dm, T, C, Rr>>> {
     #[cfg(feature = "parallel")]
     if threads.count() > 1 {
         return Box::new(crate::engine::parallel::ParallelPairForces::<E, SPIN>::new(threads.clone()));

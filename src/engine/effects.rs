@@ -43,6 +43,9 @@ pub struct Effects {
     pub damping: bool,
     /// Contacts attract (DMT): some pair that can touch has a work of adhesion above 0.
     pub cohesion: bool,
+    /// Rolling resistance: declared by `model.rolling`, some pair that can touch has a
+    /// rolling friction above 0, and the grains spin.
+    pub rolling: bool,
     pub list: Vec<Effect>,
 }
 
@@ -129,6 +132,16 @@ impl Effects {
         };
         let cohesion = sticky.is_some();
         push("cohesion (DMT)", cohesion, cohesion_why, None);
+        // Rolling resistance: declared, on the pairs with a rolling friction above 0.
+        let resisting = pairs.iter().find(|q| mix(q).rolling_friction > 0.0);
+        let law = serde_json::to_string(&scene.model.rolling).unwrap_or_default();
+        let (rolling, rolling_why) = match resisting {
+            _ if scene.model.rolling.is_none() => (false, "declared: model.rolling absent (none)".to_string()),
+            None => (false, format!("derived: model.rolling = {law}, but rolling_friction = 0 for every pair of bodies that can touch")),
+            Some(_) if !rotation => (false, format!("derived: model.rolling = {law}, but the grains do not spin (rotation off)")),
+            Some(&q) => (true, format!("declared: model.rolling = {law}; the {} pair has rolling friction {}", pair_name(mats, q), mix(&q).rolling_friction)),
+        };
+        push("rolling resistance", rolling, rolling_why, None);
         let clamp = scene.model.limit_force;
         push("normal force clamp (Fn >= 0)", clamp, format!("declared: model.limit_force = {clamp}"), Some("force clamp on"));
         let g = scene.gravity;
@@ -159,7 +172,7 @@ impl Effects {
         let frames = scene.output.frames;
         push("ParaView frames", frames > 0, format!("declared: output.frames = {frames}"), None);
         push("watchdog (overlaps, finite state)", true, "always".into(), None);
-        Effects { friction, rotation, damping, cohesion, list }
+        Effects { friction, rotation, damping, cohesion, rolling, list }
     }
 
     /// The list as a table: each effect on or off, why, and what it cost where

@@ -47,6 +47,7 @@ use crate::kernels::sweep::sort_pairs;
 use crate::kernels::threads::Threads;
 use crate::physics::contact::ContactModel;
 use crate::physics::contact::cohesion::Cohesion;
+use crate::physics::contact::rolling::Rolling;
 use crate::physics::contact::damping::Damping;
 use crate::physics::contact::normal::Normal;
 use crate::physics::contact::tangential::Tangential;
@@ -372,7 +373,7 @@ impl<const ENERGY: bool, const SPIN: bool> ParallelPairForces<ENERGY, SPIN> {
     }
 }
 
-impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, const ENERGY: bool, const SPIN: bool> Stage<ContactModel<N, Dm, T, C>> for ParallelPairForces<ENERGY, SPIN> {
+impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling, const ENERGY: bool, const SPIN: bool> Stage<ContactModel<N, Dm, T, C, Rr>> for ParallelPairForces<ENERGY, SPIN> {
     fn name(&self) -> String {
         format!("PairContacts(parallel, {} threads)", self.scratch.len())
     }
@@ -382,7 +383,7 @@ impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, const ENERGY: bool, con
         self.built_for = u64::MAX;
         if carried.is_empty() { Ok(()) } else { Err(format!("the parallel contact stage carries nothing, the checkpoint gave it {} numbers", carried.len())) }
     }
-    fn run(&mut self, w: &mut World<ContactModel<N, Dm, T, C>>) -> Result<(), Error> {
+    fn run(&mut self, w: &mut World<ContactModel<N, Dm, T, C, Rr>>) -> Result<(), Error> {
         let (n, n_free) = (w.p.len(), w.p.n_free);
         let np = w.pairs.pairs.len();
         self.since_cut += 1;
@@ -442,7 +443,7 @@ impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, const ENERGY: bool, con
                         }
                         cross_out[slot] = o;
                     };
-                    compute_pairs::<N, Dm, T, C, ENERGY, SPIN>(&view, list, &touching[..nt], &sep[..nt], &released[..nr], sink);
+                    compute_pairs::<N, Dm, T, C, Rr, ENERGY, SPIN>(&view, list, &touching[..nt], &sep[..nt], &released[..nr], sink);
                 }
                 let own_cross: &[PairOut] = cross_out;
                 let _ = published[r].set(own_cross);
@@ -491,7 +492,7 @@ impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, const ENERGY: bool, con
                     }
                 };
                 let sink = |_, ij: (usize, usize), o: PairOut| add(ij, &o, true);
-                let (ratio, kk) = compute_pairs::<N, Dm, T, C, ENERGY, SPIN>(&view, list, &touching[..nt], &sep[..nt], &released[..nr], sink);
+                let (ratio, kk) = compute_pairs::<N, Dm, T, C, Rr, ENERGY, SPIN>(&view, list, &touching[..nt], &sep[..nt], &released[..nr], sink);
                 let mut best = if kk == usize::MAX { (0.0, usize::MAX) } else { (ratio, part.start + kk) };
                 // (5) Our cross pairs' forces on our grains: a grain's pairs (g, j) with j in
                 // a later range are the last of its sequence.

@@ -21,8 +21,8 @@
 use serde::{Deserialize, Serialize};
 
 use crate::engine::simulation::Simulation;
-use crate::engine::world::{PendingKick, Zeroed};
-use crate::physics::contact::tangential::Tangential;
+use crate::engine::world::{PendingKick, State, Zeroed};
+use crate::physics::contact::model::Saved;
 use crate::physics::contact::{ContactHistory, ContactLaw, EnergyMemory};
 use crate::physics::dim::Vec2;
 use crate::physics::energy::EnergyLedger;
@@ -39,8 +39,8 @@ struct WallState {
     force_prev: Vec2,
 }
 
-/// A simulation's evolving state; `S` is the tangential history as saved
-/// ([`Tangential::Saved`]).
+/// A simulation's evolving state; `S` is a contact's state as saved
+/// ([`crate::physics::contact::model::Saved`]).
 #[derive(Serialize, Deserialize)]
 struct Snapshot<S> {
     /// What must match the simulation it is restored into.
@@ -94,7 +94,7 @@ impl<L: ContactLaw> Simulation<L> {
     /// The evolving state, encoded (postcard).
     pub fn save(&self) -> Vec<u8> {
         let w = &self.world;
-        let save = |h: &<L::Tang as Tangential>::History<f64>| L::Tang::save(*h);
+        let save = |h: &State<L>| L::save_state(*h);
         let s = Snapshot {
             model: w.law.describe(),
             stages: self.stage_names().iter().map(|n| stage_kind(n).to_string()).collect(),
@@ -109,7 +109,7 @@ impl<L: ContactLaw> Simulation<L> {
             f: w.p.f.clone(),
             torque: w.p.torque.clone(),
             walls: w.walls.iter().map(|k| WallState { control: k.control, y: k.y, x_shift: k.x_shift, v: k.v, force: k.force, force_prev: k.force_prev }).collect(),
-            wall_hist: w.wall_hist.iter().map(|hs| hs.iter().map(|h| (save(&h.tangential), h.energy)).collect()).collect(),
+            wall_hist: w.wall_hist.iter().map(|hs| hs.iter().map(|h| (save(&h.state), h.energy)).collect()).collect(),
             wall_active: w.wall_active.clone(),
             pairs: w.pairs.pairs.to_vec(),
             hist: w.pairs.hist.iter().map(save).collect(),
@@ -133,7 +133,7 @@ impl<L: ContactLaw> Simulation<L> {
     /// scene. An error says what does not fit (found before anything changes, but for
     /// the pair list's and the stages' own checks: the simulation is then not to be run).
     pub fn restore(&mut self, bytes: &[u8]) -> Result<(), String> {
-        let s: Snapshot<<L::Tang as Tangential>::Saved> = postcard::from_bytes(bytes).map_err(|e| format!("its state does not decode for this contact model ({e})"))?;
+        let s: Snapshot<Saved<L>> = postcard::from_bytes(bytes).map_err(|e| format!("its state does not decode for this contact model ({e})"))?;
         let w = &self.world;
         let n = w.p.len();
         let stages: Vec<String> = self.stage_names().iter().map(|n| stage_kind(n).to_string()).collect();
@@ -169,7 +169,7 @@ impl<L: ContactLaw> Simulation<L> {
         // pair list check their own parts, on copies first.
         let w = &mut self.world;
         let mut pairs = std::mem::take(&mut w.pairs);
-        let restored = pairs.restore(s.pairs, s.hist.into_iter().map(L::Tang::load).collect(), s.active, s.energy, &w.p.r, &w.p.m);
+        let restored = pairs.restore(s.pairs, s.hist.into_iter().map(L::load_state).collect(), s.active, s.energy, &w.p.r, &w.p.m);
         w.pairs = pairs;
         restored?;
         for (stage, c) in self.stages_mut().iter_mut().zip(&s.carried) {
@@ -181,7 +181,7 @@ impl<L: ContactLaw> Simulation<L> {
         for (k, st) in w.walls.iter_mut().zip(s.walls) {
             (k.control, k.y, k.x_shift, k.v, k.force, k.force_prev) = (st.control, st.y, st.x_shift, st.v, st.force, st.force_prev);
         }
-        w.wall_hist = s.wall_hist.into_iter().map(|hs| hs.into_iter().map(|(t, energy)| ContactHistory { tangential: L::Tang::load(t), energy }).collect()).collect();
+        w.wall_hist = s.wall_hist.into_iter().map(|hs| hs.into_iter().map(|(t, energy)| ContactHistory { state: L::load_state(t), energy }).collect()).collect();
         w.wall_active = s.wall_active;
         w.neighbours.restore(s.at_build, s.builds, s.moved_far);
         w.ledger = s.ledger;

@@ -10,6 +10,7 @@ use crate::error::Error;
 use crate::kernels::driver::{PairOut, PairSlices, PairView, compute_pairs, record_pair};
 use crate::kernels::sweep::sort_pairs;
 use crate::physics::contact::cohesion::Cohesion;
+use crate::physics::contact::rolling::Rolling;
 use crate::physics::contact::damping::Damping;
 use crate::physics::contact::normal::Normal;
 use crate::physics::contact::tangential::Tangential;
@@ -180,11 +181,11 @@ pub struct PairForces<const ENERGY: bool, const SPIN: bool> {
     released: Vec<u32>,
 }
 
-impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, const ENERGY: bool, const SPIN: bool> Stage<ContactModel<N, Dm, T, C>> for PairForces<ENERGY, SPIN> {
+impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling, const ENERGY: bool, const SPIN: bool> Stage<ContactModel<N, Dm, T, C, Rr>> for PairForces<ENERGY, SPIN> {
     fn name(&self) -> String {
         "PairContacts".into()
     }
-    fn run(&mut self, w: &mut World<ContactModel<N, Dm, T, C>>) -> Result<(), Error> {
+    fn run(&mut self, w: &mut World<ContactModel<N, Dm, T, C, Rr>>) -> Result<(), Error> {
         let mut worst = w.max_overlap;
         let mut f = std::mem::take(&mut w.p.f);
         let mut torque = std::mem::take(&mut w.p.torque);
@@ -192,7 +193,7 @@ impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, const ENERGY: bool, con
         let (nt, nr) = sort_pairs(&w.p.x, &w.boundary, pairs, &w.pairs.reach, &w.pairs.active, &[], &mut self.touching, &mut self.sep, &mut self.released);
         let (touching, sep, released) = (&self.touching[..nt], &self.sep[..nt], &self.released[..nr]);
         let view = PairView { p: &w.p, boundary: w.boundary, law: w.law, pair_table: &w.pair_table, dt: w.dt };
-        let list = PairSlices::<T> { pairs, consts, hist: &mut w.pairs.hist, energy: &mut w.pairs.energy, active: &mut w.pairs.active };
+        let list = PairSlices::<T, Rr> { pairs, consts, hist: &mut w.pairs.hist, energy: &mut w.pairs.energy, active: &mut w.pairs.active };
         // Each pair's force goes to its grains as it comes, in list order.
         let n = f.len();
         let (fs, ts) = (&mut f[..n], &mut torque[..n]);
@@ -204,7 +205,7 @@ impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, const ENERGY: bool, con
                 ts[j] -= o.torque[1];
             }
         };
-        let (ratio, k) = compute_pairs::<N, Dm, T, C, ENERGY, SPIN>(&view, list, touching, sep, released, sink);
+        let (ratio, k) = compute_pairs::<N, Dm, T, C, Rr, ENERGY, SPIN>(&view, list, touching, sep, released, sink);
         if ratio > worst.0 {
             let [i, j] = pairs.pairs()[k];
             worst = (ratio, i as usize, j as usize);
@@ -219,10 +220,11 @@ impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, const ENERGY: bool, con
 /// The contact input of free grain `i` touching flat `wall` (normal `n` into the grain,
 /// overlap `dn`): R* = r, m* = m. Shared by the wall contact stage and the record of it.
 #[inline(always)]
-fn wall_input<T: Tangential>(lever: crate::physics::contact::LeverArm, p: &crate::physics::particles::Particles, i: usize, wall: &crate::physics::walls::Wall, n: Vec2, dn: f64, dt: f64) -> ContactInput {
+fn wall_input<T: Tangential, Rr: Rolling>(lever: crate::physics::contact::LeverArm, p: &crate::physics::particles::Particles, i: usize, wall: &crate::physics::walls::Wall, n: Vec2, dn: f64, dt: f64) -> ContactInput {
     let ri = p.r[i];
     let spin = if T::FRICTION { lever.arm(ri, dn) * p.omega[i] } else { 0.0 };
-    ContactInput { n, dn, r_star: ri, sqrt_m_star: p.m[i].sqrt(), v_rel: p.v[i] - wall.v, spin, dt, tangential_scale: 1.0 }
+    let (roll, roll_scale) = if Rr::ON { (p.omega[i], lever.wall_rolling(ri, dn)) } else { (0.0, 1.0) };
+    ContactInput { n, dn, r_star: ri, sqrt_m_star: p.m[i].sqrt(), v_rel: p.v[i] - wall.v, spin, dt, tangential_scale: 1.0, roll, roll_scale }
 }
 
 /// Record every touching contact of this step, grain-grain and grain-flat wall, as the
@@ -232,11 +234,11 @@ fn wall_input<T: Tangential>(lever: crate::physics::contact::LeverArm, p: &crate
 /// `output.contacts` asks, and at the other steps a flag test.
 pub struct RecordContacts<const SPIN: bool>;
 
-impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, const SPIN: bool> Stage<ContactModel<N, Dm, T, C>> for RecordContacts<SPIN> {
+impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling, const SPIN: bool> Stage<ContactModel<N, Dm, T, C, Rr>> for RecordContacts<SPIN> {
     fn name(&self) -> String {
         "RecordContacts".into()
     }
-    fn run(&mut self, w: &mut World<ContactModel<N, Dm, T, C>>) -> Result<(), Error> {
+    fn run(&mut self, w: &mut World<ContactModel<N, Dm, T, C, Rr>>) -> Result<(), Error> {
         if !w.probe.wanted {
             return Ok(());
         }
@@ -249,7 +251,7 @@ impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, const SPIN: bool> Stage
         pr.walls = w.walls.iter().map(|wall| (wall.contact_surface(), wall.v)).collect();
         let view = PairView { p: &w.p, boundary: w.boundary, law: w.law, pair_table: &w.pair_table, dt: w.dt };
         for (k, &[i, j]) in w.pairs.pairs.checked().pairs().iter().enumerate() {
-            if let Some(c) = record_pair::<N, Dm, T, C, SPIN>(&view, (i as usize, j as usize), &w.pairs.consts[k], &w.pairs.hist[k]) {
+            if let Some(c) = record_pair::<N, Dm, T, C, Rr, SPIN>(&view, (i as usize, j as usize), &w.pairs.consts[k], &w.pairs.hist[k]) {
                 out.push(c);
             }
         }
@@ -268,9 +270,9 @@ impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, const SPIN: bool> Stage
                 }
                 // As FlatWallForces computes it, on a copy of the history.
                 let dn = ri - gap;
-                let input = wall_input::<T>(lever, p, i, wall, n, dn, w.dt);
+                let input = wall_input::<T, Rr>(lever, p, i, wall, n, dn, w.dt);
                 let pm = w.pair_table.get(p.material[i] as usize, wall.material);
-                let mut h = w.wall_hist[k][i].tangential;
+                let mut h = w.wall_hist[k][i].state;
                 let c = model.force(&input, pm, &mut h);
                 out.push(ContactRecord {
                     i: i as u32,
@@ -294,11 +296,11 @@ impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, const SPIN: bool> Stage
 /// Contacts of free grains with flat walls (R* = r, m* = m).
 pub struct FlatWallForces<const ENERGY: bool>;
 
-impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, const ENERGY: bool> Stage<ContactModel<N, Dm, T, C>> for FlatWallForces<ENERGY> {
+impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling, const ENERGY: bool> Stage<ContactModel<N, Dm, T, C, Rr>> for FlatWallForces<ENERGY> {
     fn name(&self) -> String {
         "FlatWallContacts".into()
     }
-    fn run(&mut self, w: &mut World<ContactModel<N, Dm, T, C>>) -> Result<(), Error> {
+    fn run(&mut self, w: &mut World<ContactModel<N, Dm, T, C, Rr>>) -> Result<(), Error> {
         let model = w.law;
         let lever = model.options.lever_arm;
         let dt = w.dt;
@@ -319,7 +321,7 @@ impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, const ENERGY: bool> Sta
                     if active[i] {
                         let spin = if T::FRICTION { ri * p.omega[i] } else { 0.0 };
                         let vc = p.v[i] - wall.v + spin * Vec2::new(n.y, -n.x);
-                        model.release::<ENERGY>(vc, n, dt, &mut h.tangential, &mut h.energy);
+                        model.release::<ENERGY>(vc, n, p.omega[i], dt, &mut h.state, &mut h.energy);
                         if ENERGY {
                             w.ledger.add(&std::mem::take(&mut h.energy.sums));
                         }
@@ -328,7 +330,7 @@ impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, const ENERGY: bool> Sta
                     continue;
                 }
                 let dn = ri - gap;
-                let input = wall_input::<T>(lever, p, i, wall, n, dn, dt);
+                let input = wall_input::<T, Rr>(lever, p, i, wall, n, dn, dt);
                 let pm = w.pair_table.get(p.material[i] as usize, wall.material);
                 let c = model.touch::<ENERGY>(&input, pm, h, &mut w.ledger);
                 active[i] = true;
@@ -336,6 +338,9 @@ impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, const ENERGY: bool> Sta
                 on_wall -= c.force;
                 if T::FRICTION {
                     p.torque[i] -= lever.wall_torque_arm(ri, dn) * cross(n, c.tangential);
+                }
+                if Rr::ON {
+                    p.torque[i] += c.rolling;
                 }
                 if dn / ri > worst.0 {
                     worst = (dn / ri, i, usize::MAX - k);

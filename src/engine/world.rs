@@ -7,7 +7,7 @@ use crate::engine::neighbor::Neighbours;
 use crate::error::{Error, Shown};
 use crate::kernels::pairs::PairList;
 use crate::physics::boundary::Boundary;
-use crate::physics::contact::tangential::Tangential;
+use crate::physics::contact::model::Held;
 use crate::physics::contact::{ContactHistory, ContactLaw, ContactRecord};
 use crate::physics::dim::Vec2;
 use crate::physics::energy::{EnergyLedger, EnergyRow};
@@ -15,8 +15,10 @@ use crate::physics::material::PairTable;
 use crate::physics::particles::Particles;
 use crate::physics::walls::Wall;
 
+/// A contact law's state of one contact ([`Held`]: tangential and rolling).
+pub type State<L> = Held<<L as ContactLaw>::Tang, <L as ContactLaw>::Roll>;
 /// History type of a contact law.
-pub type Hist<L> = ContactHistory<<<L as ContactLaw>::Tang as Tangential>::History<f64>>;
+pub type Hist<L> = ContactHistory<State<L>>;
 
 /// Everything that evolves.
 pub struct World<L: ContactLaw> {
@@ -24,7 +26,7 @@ pub struct World<L: ContactLaw> {
     pub boundary: Boundary,
     pub law: L,
     pub pair_table: PairTable,
-    pub pairs: PairList<<L::Tang as Tangential>::History<f64>>,
+    pub pairs: PairList<State<L>>,
     pub walls: Vec<Wall>,
     /// History of each free grain against each flat wall: `wall_hist[wall][grain]`.
     pub wall_hist: Vec<Vec<Hist<L>>>,

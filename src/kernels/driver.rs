@@ -10,10 +10,12 @@ use simba::simd::{SimdBool, SimdPartialOrd, SimdValue};
 use crate::kernels::pairs::{CheckedPairs, PairConst};
 use crate::physics::boundary::Boundary;
 use crate::physics::contact::cohesion::Cohesion;
+use crate::physics::contact::rolling::Rolling;
 use crate::physics::contact::damping::Damping;
 use crate::physics::contact::normal::Normal;
 use crate::physics::contact::tangential::Tangential;
 use crate::physics::contact::model::ContactState;
+use crate::physics::contact::model::Held;
 use crate::physics::contact::{ContactInput, ContactLaw, ContactModel, ContactRecord, EnergyMemory, LeverArm, Partner};
 use crate::physics::dim::{Vec2, cross};
 use crate::physics::lanes::{LANES, Lanes, Real, gather, gather2, lane2};
@@ -36,32 +38,35 @@ pub struct PairOut {
 /// rotate), relative velocity and constants.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-fn pair_input<R: Real, T: Tangential, const SPIN: bool>(lever: LeverArm, d: Vector2<R>, ri: R, rj: R, wi: R, wj: R, v_rel: Vector2<R>, r_star: R, sqrt_m_star: R, dt: R) -> ContactInput<R> {
+fn pair_input<R: Real, T: Tangential, Rr: Rolling, const SPIN: bool>(lever: LeverArm, d: Vector2<R>, ri: R, rj: R, wi: R, wj: R, v_rel: Vector2<R>, r_star: R, sqrt_m_star: R, dt: R) -> ContactInput<R> {
     let radsum = ri + rj;
     let r = d.norm_squared().simd_sqrt();
     let n = d * r.simd_recip();
     let dn = radsum - r;
     let spin = if T::FRICTION && SPIN { lever.arm(ri, dn) * wi + lever.arm(rj, dn) * wj } else { R::zero() };
     let tangential_scale = if T::FRICTION { lever.translation_scale(radsum, dn) } else { R::one() };
-    ContactInput { n, dn, r_star, sqrt_m_star, v_rel, spin, dt, tangential_scale }
+    let roll = if Rr::ON && SPIN { wi - wj } else { R::zero() };
+    ContactInput { n, dn, r_star, sqrt_m_star, v_rel, spin, dt, tangential_scale, roll, roll_scale: R::one() }
 }
 
-/// The torques `-a n x Ft` to subtract from grains i and j.
+/// The torques to subtract from grains i and j: `-a n x Ft` and, with rolling
+/// resistance, the rolling torque `rolling` on i (its opposite on j).
 #[inline(always)]
-fn pair_torque<R: Real>(lever: LeverArm, c: &ContactInput<R>, ft: Vector2<R>, ri: R, rj: R) -> [R; 2] {
+fn pair_torque<R: Real, Rr: Rolling>(lever: LeverArm, c: &ContactInput<R>, ft: Vector2<R>, rolling: R, ri: R, rj: R) -> [R; 2] {
     let t = cross(c.n, ft);
-    [lever.torque_arm(ri, c.dn) * t, lever.torque_arm(rj, c.dn) * t]
+    let (ti, tj) = (lever.torque_arm(ri, c.dn) * t, lever.torque_arm(rj, c.dn) * t);
+    if Rr::ON { [ti - rolling, tj + rolling] } else { [ti, tj] }
 }
 
 /// One pair of the Verlet list: the contact force (touching), the end of a contact
 /// (released), or nothing; tangential state `h` and (with `ENERGY`) energy memory `e`
 /// updated.
 #[inline(always)]
-pub fn pair_contact<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, const ENERGY: bool>(
-    w: &PairView<'_, ContactModel<N, Dm, T, C>>,
+pub fn pair_contact<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling, const ENERGY: bool>(
+    w: &PairView<'_, ContactModel<N, Dm, T, C, Rr>>,
     pair: [u32; 2],
     pc: &PairConst,
-    h: &mut T::History<f64>,
+    h: &mut Held<T, Rr>,
     e: &mut EnergyMemory,
     active: &mut bool,
 ) -> PairOut {
@@ -77,12 +82,13 @@ pub fn pair_contact<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, const EN
             let n = d / rsq.sqrt();
             let spin = if T::FRICTION { ri * p.omega[i] + rj * p.omega[j] } else { 0.0 };
             let vc = p.v[i] - p.v[j] + spin * Vec2::new(n.y, -n.x);
-            model.release::<ENERGY>(vc, n, w.dt, h, e);
+            let roll = if Rr::ON { p.omega[i] - p.omega[j] } else { 0.0 };
+            model.release::<ENERGY>(vc, n, roll, w.dt, h, e);
             *active = false;
         }
         return PairOut::default();
     }
-    let (o, n, state) = one_pair::<N, Dm, T, C, true>(w, (i, j), d, pc, h, active);
+    let (o, n, state) = one_pair::<N, Dm, T, C, Rr, true>(w, (i, j), d, pc, h, active);
     if ENERGY {
         model.energy_step(n, w.dt, &state, e);
     }
@@ -96,9 +102,9 @@ pub fn pair_contact<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, const EN
 /// (grains that do not rotate) the spins are not read and the torques not computed.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-fn four_pairs<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, const ENERGY: bool, const SPIN: bool>(
-    w: &PairView<'_, ContactModel<N, Dm, T, C>>,
-    list: PairSlices<'_, T>,
+fn four_pairs<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling, const ENERGY: bool, const SPIN: bool>(
+    w: &PairView<'_, ContactModel<N, Dm, T, C, Rr>>,
+    list: PairSlices<'_, T, Rr>,
     single: Option<&PairMaterial<Lanes>>,
     ks: &[u32],
     ds: &[Vec2],
@@ -131,7 +137,7 @@ fn four_pairs<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, const ENERGY: 
         let (vi, vj) = v.at(ks[l]);
         vi - vj
     });
-    let input = pair_input::<Lanes, T, SPIN>(lever, d, ri, rj, wi, wj, v_rel, gather(|l| pc[l].r_star), gather(|l| pc[l].sqrt_m_star), Lanes::splat(w.dt));
+    let input = pair_input::<Lanes, T, Rr, SPIN>(lever, d, ri, rj, wi, wj, v_rel, gather(|l| pc[l].r_star), gather(|l| pc[l].sqrt_m_star), Lanes::splat(w.dt));
     let pm = match single {
         Some(pm) => *pm,
         None => {
@@ -142,9 +148,9 @@ fn four_pairs<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, const ENERGY: 
             }))
         }
     };
-    let mut h = T::gather(std::array::from_fn(|l| &hist[ks[l]]));
+    let mut h = ContactModel::<N, Dm, T, C, Rr>::gather(std::array::from_fn(|l| &hist[ks[l]]));
     let c = model.force(&input, &pm, &mut h);
-    let torque = if T::FRICTION && SPIN { pair_torque(lever, &input, c.tangential.elastic + c.tangential.damping, ri, rj) } else { [Lanes::splat(0.0); 2] };
+    let torque = if T::FRICTION && SPIN { pair_torque::<_, Rr>(lever, &input, c.tangential.elastic + c.tangential.damping, c.rolling, ri, rj) } else { [Lanes::splat(0.0); 2] };
     let ratio = input.dn * gather(|l| pc[l].inv_r_min);
     // The largest overlap so far: a lane beats it rarely, so one test per four pairs.
     let beats = ratio.simd_gt(Lanes::splat(best.0)).bitmask();
@@ -157,14 +163,14 @@ fn four_pairs<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, const ENERGY: 
     }
     // With the ledger, the energy memories too, in lanes.
     if ENERGY {
-        let mut e = EnergyMemory::gather(std::array::from_fn(|l| &list.energy[ks[l]]), T::FRICTION);
+        let mut e = EnergyMemory::gather(std::array::from_fn(|l| &list.energy[ks[l]]), T::FRICTION, Rr::ON);
         model.energy_step(input.n, input.dt, &c, &mut e);
         for (l, &k) in ks.iter().enumerate() {
             e.store_lane(l, &mut list.energy[k], T::FRICTION);
         }
     }
     for l in 0..LANES {
-        hist[ks[l]] = T::lane(&h, l);
+        hist[ks[l]] = ContactModel::<N, Dm, T, C, Rr>::lane(&h, l);
         active[ks[l]] = true;
         sink(ks[l], ij[l], PairOut { force: lane2(&c.force, l), torque: [torque[0].extract(l), torque[1].extract(l)], ratio: ratio.extract(l) });
     }
@@ -174,21 +180,21 @@ fn four_pairs<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, const ENERGY: 
 /// its output, advancing its tangential state `h`, and what its energy accounting needs
 /// (the normal and the step's contact state).
 #[inline(always)]
-fn one_pair<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, const SPIN: bool>(
-    w: &PairView<'_, ContactModel<N, Dm, T, C>>,
+fn one_pair<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling, const SPIN: bool>(
+    w: &PairView<'_, ContactModel<N, Dm, T, C, Rr>>,
     (i, j): (usize, usize),
     d: Vec2,
     pc: &PairConst,
-    h: &mut T::History<f64>,
+    h: &mut Held<T, Rr>,
     active: &mut bool,
 ) -> (PairOut, Vec2, ContactState) {
     let (model, p) = (w.law, w.p);
     let lever = model.options.lever_arm;
-    let input = pair_input::<f64, T, SPIN>(lever, d, p.r[i], p.r[j], p.omega[i], p.omega[j], p.v[i] - p.v[j], pc.r_star, pc.sqrt_m_star, w.dt);
+    let input = pair_input::<f64, T, Rr, SPIN>(lever, d, p.r[i], p.r[j], p.omega[i], p.omega[j], p.v[i] - p.v[j], pc.r_star, pc.sqrt_m_star, w.dt);
     let pm = w.pair_table.get(p.material[i] as usize, p.material[j] as usize);
     let c = model.force(&input, pm, h);
     *active = true;
-    let torque = if T::FRICTION && SPIN { pair_torque(lever, &input, c.tangential.elastic + c.tangential.damping, p.r[i], p.r[j]) } else { [0.0, 0.0] };
+    let torque = if T::FRICTION && SPIN { pair_torque::<_, Rr>(lever, &input, c.tangential.elastic + c.tangential.damping, c.rolling, p.r[i], p.r[j]) } else { [0.0, 0.0] };
     (PairOut { force: c.force, torque, ratio: input.dn * pc.inv_r_min }, input.n, c)
 }
 
@@ -196,7 +202,7 @@ fn one_pair<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, const SPIN: bool
 /// (positions, velocities and tangential state `h` as they are now): its record, or
 /// `None` when it does not touch. The same function of the same inputs as the stage's
 /// (`one_pair`, whose lanes give the same bits), on a copy of the state: nothing moves.
-pub fn record_pair<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, const SPIN: bool>(w: &PairView<'_, ContactModel<N, Dm, T, C>>, (i, j): (usize, usize), pc: &PairConst, h: &T::History<f64>) -> Option<ContactRecord> {
+pub fn record_pair<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling, const SPIN: bool>(w: &PairView<'_, ContactModel<N, Dm, T, C, Rr>>, (i, j): (usize, usize), pc: &PairConst, h: &Held<T, Rr>) -> Option<ContactRecord> {
     let p = w.p;
     let d = w.boundary.image(p.x[i] - p.x[j]);
     let (ri, rj) = (p.r[i], p.r[j]);
@@ -204,7 +210,7 @@ pub fn record_pair<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, const SPI
         return None;
     }
     let (mut h, mut active) = (*h, true);
-    let (_, n, c) = one_pair::<N, Dm, T, C, SPIN>(w, (i, j), d, pc, &mut h, &mut active);
+    let (_, n, c) = one_pair::<N, Dm, T, C, Rr, SPIN>(w, (i, j), d, pc, &mut h, &mut active);
     let dn = ri + rj - d.norm();
     Some(ContactRecord {
         i: i as u32,
@@ -222,10 +228,10 @@ pub fn record_pair<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, const SPI
 
 /// A part of the pair list: the pairs, their constants, tangential states, energy
 /// memories (empty without the energy ledger) and touching flags.
-pub struct PairSlices<'a, T: Tangential> {
+pub struct PairSlices<'a, T: Tangential, Rr: Rolling> {
     pub pairs: CheckedPairs<'a>,
     pub consts: &'a [PairConst],
-    pub hist: &'a mut [T::History<f64>],
+    pub hist: &'a mut [Held<T, Rr>],
     pub energy: &'a mut [EnergyMemory],
     pub active: &'a mut [bool],
 }
@@ -238,9 +244,9 @@ pub struct PairSlices<'a, T: Tangential> {
 /// them for the ledger. Returns the largest overlap over the smaller radius of the
 /// touching pairs and the index (in the part) of the first pair that has it,
 /// `(0, usize::MAX)` if none touches.
-pub fn compute_pairs<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, const ENERGY: bool, const SPIN: bool>(
-    w: &PairView<'_, ContactModel<N, Dm, T, C>>,
-    list: PairSlices<'_, T>,
+pub fn compute_pairs<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling, const ENERGY: bool, const SPIN: bool>(
+    w: &PairView<'_, ContactModel<N, Dm, T, C, Rr>>,
+    list: PairSlices<'_, T, Rr>,
     touching: &[u32],
     sep: &[Vec2],
     released: &[u32],
@@ -252,13 +258,13 @@ pub fn compute_pairs<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, const E
     let single = w.pair_table.single().map(|m| PairMaterial::gather([m; LANES]));
     let PairSlices { pairs, consts, hist, energy, active } = list;
     for (ks, ds) in touching[..quads].chunks_exact(LANES).zip(sep.chunks_exact(LANES)) {
-        let slices = PairSlices::<T> { pairs, consts, hist: &mut *hist, energy: &mut *energy, active: &mut *active };
-        four_pairs::<N, Dm, T, C, ENERGY, SPIN>(w, slices, single.as_ref(), ks, ds, &mut sink, &mut best);
+        let slices = PairSlices::<T, Rr> { pairs, consts, hist: &mut *hist, energy: &mut *energy, active: &mut *active };
+        four_pairs::<N, Dm, T, C, Rr, ENERGY, SPIN>(w, slices, single.as_ref(), ks, ds, &mut sink, &mut best);
     }
     for (m, &k) in touching.iter().enumerate().skip(quads) {
         let k = k as usize;
         let [i, j] = pairs.pairs()[k].map(|g| g as usize);
-        let (o, n, state) = one_pair::<N, Dm, T, C, SPIN>(w, (i, j), sep[m], &consts[k], &mut hist[k], &mut active[k]);
+        let (o, n, state) = one_pair::<N, Dm, T, C, Rr, SPIN>(w, (i, j), sep[m], &consts[k], &mut hist[k], &mut active[k]);
         if o.ratio > best.0 {
             best = (o.ratio, k);
         }
@@ -271,7 +277,7 @@ pub fn compute_pairs<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, const E
     for &k in released {
         let k = k as usize;
         let e = if ENERGY { &mut energy[k] } else { &mut none };
-        pair_contact::<N, Dm, T, C, ENERGY>(w, pairs.pairs()[k], &consts[k], &mut hist[k], e, &mut active[k]);
+        pair_contact::<N, Dm, T, C, Rr, ENERGY>(w, pairs.pairs()[k], &consts[k], &mut hist[k], e, &mut active[k]);
     }
     best
 }

@@ -6,7 +6,7 @@
 //! that does not match the contact-point velocity, a wall force not counted) shows up
 //! at once in the residual.
 //!
-//! `residual = (E_kin + E_rot + E_wall + U_n + U_t) - E_0 + D_n + D_t + D_slip + D_general
+//! `residual = (E_kin + E_rot + E_wall + U_n + U_t) - E_0 + D_n + D_t + D_slip + D_general + D_roll
 //!             - W_t - W_walls - W_load - W_gravity`
 //! where `W_t` ("tangential model work") is the energy the tangential spring gains
 //! because its stiffness kt(dn) and its frame change under it. It is a property of the
@@ -40,6 +40,9 @@ pub struct EnergyLedger {
     pub friction: f64,
     /// Energy dissipated by the general (viscous, per-grain) damping, J.
     pub general_damping: f64,
+    /// Work taken from the grains by the rolling resistance's torques, J: dissipated, or
+    /// held for a while by a rolling spring (EPSD2, SDS) that is not sliding.
+    pub rolling: f64,
     /// Energy the tangential springs gained from stiffness and frame changes, less the
     /// elastic energy they hold now (the sum of `E_slip + W_spring`, see the module), J.
     pub tangential_model: f64,
@@ -70,6 +73,7 @@ impl EnergyLedger {
         self.tangential_damping += s.tangential_damping;
         self.friction += s.friction;
         self.tangential_model += s.tangential_model;
+        self.rolling += s.rolling;
     }
     /// The tangential model's work `W_t`: what the ledger keeps plus the elastic energy
     /// the tangential springs hold now, J.
@@ -91,6 +95,8 @@ pub struct EnergySums<R = f64> {
     /// Tangential model work less the change of the stored tangential energy
     /// (`E_slip + W_spring`), J.
     pub tangential_model: R,
+    /// Taken by the rolling torque, J.
+    pub rolling: R,
 }
 
 impl std::ops::Add for EnergySums {
@@ -101,6 +107,7 @@ impl std::ops::Add for EnergySums {
             tangential_damping: self.tangential_damping + b.tangential_damping,
             friction: self.friction + b.friction,
             tangential_model: self.tangential_model + b.tangential_model,
+            rolling: self.rolling + b.rolling,
         }
     }
 }
@@ -131,6 +138,8 @@ pub struct EnergyRow {
     pub dissipated_tangential_damping_j: f64,
     pub dissipated_friction_j: f64,
     pub dissipated_general_damping_j: f64,
+    /// Taken by the rolling resistance's torques (0 without), J.
+    pub dissipated_rolling_j: f64,
     pub tangential_model_work_j: f64,
     pub work_walls_j: f64,
     pub work_load_j: f64,
@@ -156,7 +165,7 @@ impl EnergyRow {
     }
     /// Energy dissipated so far, J.
     pub fn dissipated(&self) -> f64 {
-        self.dissipated_normal_damping_j + self.dissipated_tangential_damping_j + self.dissipated_friction_j + self.dissipated_general_damping_j
+        self.dissipated_normal_damping_j + self.dissipated_tangential_damping_j + self.dissipated_friction_j + self.dissipated_general_damping_j + self.dissipated_rolling_j
     }
     pub fn new(time: f64, kin: (f64, f64, f64), ledger: &EnergyLedger, initial: f64) -> Self {
         let mut r = EnergyRow {
@@ -170,6 +179,7 @@ impl EnergyRow {
             dissipated_tangential_damping_j: ledger.tangential_damping,
             dissipated_friction_j: ledger.friction,
             dissipated_general_damping_j: ledger.general_damping,
+            dissipated_rolling_j: ledger.rolling,
             tangential_model_work_j: ledger.tangential_model_work(),
             work_walls_j: ledger.walls,
             work_load_j: ledger.load,

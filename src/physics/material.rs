@@ -44,6 +44,13 @@ pub struct Material {
     /// pair takes the geometric mean `sqrt(w1 w2)`. Left out of written scenes when 0.
     #[serde(default, skip_serializing_if = "is_zero")]
     pub work_of_adhesion: f64,
+    /// Rolling friction coefficient mu_r, >= 0, dimensionless: the largest rolling torque
+    /// is `mu_r R* |Fn|` (LIGGGHTS' `coefficientRollingFriction`, LAMMPS' `mu_roll`). Read
+    /// only when `model.rolling` names a law
+    /// ([`crate::physics::contact::rolling`]). A pair takes the smaller. Default 0; left
+    /// out of written scenes when 0.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub rolling_friction: f64,
 }
 
 fn is_zero(x: &f64) -> bool {
@@ -79,6 +86,7 @@ impl Default for Material {
             restitution: default_e_rest(),
             friction: default_mu(),
             work_of_adhesion: 0.0,
+            rolling_friction: 0.0,
         }
     }
 }
@@ -98,6 +106,8 @@ impl Material {
         check(mu.is_finite() && mu >= 0.0, at, "friction", mu, ">= 0")?;
         let w = self.work_of_adhesion;
         check(w.is_finite() && w >= 0.0, at, "work_of_adhesion", w, ">= 0 J/m^2")?;
+        let mr = self.rolling_friction;
+        check(mr.is_finite() && mr >= 0.0, at, "rolling_friction", mr, ">= 0")?;
         Ok(())
     }
 
@@ -134,6 +144,8 @@ pub struct PairMaterial<R = f64> {
     /// `2 pi w` with w the pair's work of adhesion, N/m: the DMT pull-off force is
     /// `pulloff R*` ([`crate::physics::contact::cohesion`]).
     pub pulloff: R,
+    /// Rolling friction coefficient mu_r of the pair (the smaller one).
+    pub rolling_friction: R,
 }
 
 impl PairMaterial<crate::physics::lanes::Lanes> {
@@ -150,6 +162,7 @@ impl PairMaterial<crate::physics::lanes::Lanes> {
             viscous_n: gather(|l| pm[l].viscous_n),
             viscous_t: gather(|l| pm[l].viscous_t),
             pulloff: gather(|l| pm[l].pulloff),
+            rolling_friction: gather(|l| pm[l].rolling_friction),
         }
     }
 }
@@ -169,7 +182,7 @@ impl PairMaterial {
         let c = -2.0 * SQRT_FIVE_SIXTHS * beta;
         let (viscous_n, viscous_t) = (c * (2.0 * e_star).sqrt(), c * (8.0 * g_star).sqrt());
         let pulloff = 2.0 * std::f64::consts::PI * (a.work_of_adhesion * b.work_of_adhesion).sqrt();
-        PairMaterial { e_star, g_star, restitution, beta, friction: a.friction.min(b.friction), viscous_n, viscous_t, pulloff }
+        PairMaterial { e_star, g_star, restitution, beta, friction: a.friction.min(b.friction), viscous_n, viscous_t, pulloff, rolling_friction: a.rolling_friction.min(b.rolling_friction) }
     }
 }
 

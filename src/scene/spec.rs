@@ -313,6 +313,35 @@ pub enum TangentialSpec {
     Frictionless,
 }
 
+/// Rolling resistance (`model.rolling`): a torque against the relative spin w_i - w_j
+/// of two bodies in contact, at most `mu_r R* |Fn|` with `mu_r` the pair's
+/// `materials[].rolling_friction` ([`crate::physics::contact::rolling`]). Compiled with
+/// either normal law, the restitution damping and the total-displacement tangential
+/// history, without cohesion.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum RollingSpec {
+    /// No rolling resistance (the default).
+    #[default]
+    None,
+    /// Constant directional torque (LIGGGHTS `rolling_friction cdt`): `mu_r R* kn dn`
+    /// against the relative spin.
+    Cdt,
+    /// Elastic-plastic torque spring (LIGGGHTS `rolling_friction epsd2`): stiffness
+    /// `kt R*^2`, loaded by the relative rotation, capped at `mu_r R* |Fn|`.
+    Epsd2,
+    /// Spring-dashpot-slider on the rolling displacement (LAMMPS `rolling sds`):
+    /// `stiffness` k (N/m, > 0) and `damping` g (kg/s, >= 0); the force `-k s - g R* w`
+    /// capped at `mu_r |Fn|` acts at arm R*.
+    Sds { stiffness: f64, damping: f64 },
+}
+
+impl RollingSpec {
+    pub fn is_none(&self) -> bool {
+        *self == RollingSpec::None
+    }
+}
+
 #[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ModelSpec {
@@ -329,6 +358,12 @@ pub struct ModelSpec {
     pub damping: DampingSpec,
     #[serde(default)]
     pub tangential: TangentialSpec,
+    /// Rolling resistance: `"none"` (default), `"cdt"`, `"epsd2"` or `{"sds":
+    /// {"stiffness": k, "damping": g}}` (see [`RollingSpec`]); it acts on the pairs
+    /// whose materials have a `rolling_friction` above 0. Left out of written scenes
+    /// when none.
+    #[serde(default, skip_serializing_if = "RollingSpec::is_none")]
+    pub rolling: RollingSpec,
     /// Clamp Fn >= 0 (LIGGGHTS `limitForce`). Default false.
     #[serde(default)]
     pub limit_force: bool,
@@ -378,7 +413,7 @@ impl DampingSpec {
 
 impl Default for ModelSpec {
     fn default() -> Self {
-        ModelSpec { normal: NormalLaw::Hertz, damping: DampingSpec::Restitution, tangential: TangentialSpec::default(), limit_force: false, lever_arm: LeverArm::default(), rotation: true, general_damping: None }
+        ModelSpec { normal: NormalLaw::Hertz, damping: DampingSpec::Restitution, tangential: TangentialSpec::default(), rolling: RollingSpec::None, limit_force: false, lever_arm: LeverArm::default(), rotation: true, general_damping: None }
     }
 }
 

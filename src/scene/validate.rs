@@ -175,6 +175,20 @@ impl Scene {
             check(!tsuji, &at, "work_of_adhesion", w, &format!("0 with model.damping = tsuji (compiled: {compiled})"))?;
             check(!self.model.limit_force, &at, "work_of_adhesion", w, "0 with model.limit_force = true (the clamp Fn >= 0 would remove the attraction; LAMMPS refuses limit_damping with dmt too)")?;
         }
+        // Rolling resistance is compiled with the restitution damping, the total
+        // displacement and spins, without cohesion.
+        if !self.model.rolling.is_none() {
+            let compiled = crate::physics::contact::model::COMPILED;
+            let name = serde_json::to_string(&self.model.rolling).unwrap_or_default();
+            check(self.model.tangential == TangentialSpec::TotalDisplacement, "model", "rolling", &name, &format!("\"none\" with model.tangential other than total_displacement (compiled: {compiled})"))?;
+            check(!tsuji, "model", "rolling", &name, &format!("\"none\" with model.damping = tsuji (compiled: {compiled})"))?;
+            check(self.model.rotation, "model", "rolling", &name, "\"none\" with model.rotation = false (a rolling torque acts on spins)")?;
+            check(self.adhesive_material().is_none(), "model", "rolling", &name, &format!("\"none\" with a work_of_adhesion above 0 (compiled: {compiled})"))?;
+            if let crate::scene::RollingSpec::Sds { stiffness, damping } = self.model.rolling {
+                check(finite_pos(stiffness), "model.rolling.sds", "stiffness", stiffness, "> 0 N/m")?;
+                check(damping.is_finite() && damping >= 0.0, "model.rolling.sds", "damping", damping, ">= 0 kg/s")?;
+            }
+        }
         if let Some(c) = self.model.general_damping {
             check(finite_pos(c), "model", "general_damping", c, "> 0 1/s (omit it for none)")?;
         }

@@ -300,8 +300,8 @@ fn linear_spring_cases(out: &mut Vec<Case>) {
 /// vn = 0.2 m/s with spin w0 r / vn from -10 to 10. Sphere in the plane, t_c/500.
 fn chung_ooi_cases(out: &mut Vec<Case>) {
     use crate::physics::dim::GrainShape;
-    let al2o3 = Material { name: "Al2O3".into(), youngs_modulus: 380e9, poisson_ratio: 0.23, density: 4000.0, restitution: 0.98, friction: 0.092, work_of_adhesion: 0.0 };
-    let al = Material { name: "Al".into(), youngs_modulus: 70e9, poisson_ratio: 0.33, density: 2700.0, restitution: 0.5, friction: 0.4, work_of_adhesion: 0.0 };
+    let al2o3 = Material { name: "Al2O3".into(), youngs_modulus: 380e9, poisson_ratio: 0.23, density: 4000.0, restitution: 0.98, friction: 0.092, work_of_adhesion: 0.0, rolling_friction: 0.0 };
+    let al = Material { name: "Al".into(), youngs_modulus: 70e9, poisson_ratio: 0.33, density: 2700.0, restitution: 0.5, friction: 0.4, work_of_adhesion: 0.0, rolling_friction: 0.0 };
     for (form, code) in [(TangentialSpec::TotalDisplacement, Code::Liggghts), (TangentialSpec::IncrementalForce, Code::Yade)] {
         let tag = if code == Code::Liggghts { "history" } else { "incremental" };
         for a in [5.0f64, 15.0, 25.0, 35.0, 45.0, 55.0, 65.0, 75.0, 85.0] {

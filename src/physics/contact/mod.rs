@@ -6,6 +6,7 @@ pub mod damping;
 pub mod model;
 pub mod normal;
 pub mod record;
+pub mod rolling;
 pub mod tangential;
 
 pub use record::{ContactRecord, Partner};

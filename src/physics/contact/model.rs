@@ -1,6 +1,6 @@
 //! A contact model: a normal law (Hertz or the linear spring), a damping form, a
-//! tangential formulation and a cohesion model, composed at compile time. Each named
-//! combination is one monomorphized kernel.
+//! tangential formulation, a cohesion model and a rolling resistance, composed at
+//! compile time. Each named combination is one monomorphized kernel.
 
 use std::marker::PhantomData;
 
@@ -10,6 +10,7 @@ use serde::{Deserialize, Serialize};
 use nalgebra::Vector2;
 
 use super::cohesion::{Cohesion, Dmt, NoCohesion};
+use super::rolling::{Cdt, Epsd2, NoRolling, Rolling, RollingInput, Sds};
 use super::damping::{Damping, LinearRestitution, TsujiFit, Undamped, Viscoelastic};
 use super::normal::{Hertz, Hooke, Normal};
 use super::tangential::{Frictionless, IncrementalForce, Tangential, TangentialForce, TangentialInput, TotalDisplacement};
@@ -62,6 +63,17 @@ impl LeverArm {
             _ => self.torque_arm(r, dn),
         }
     }
+    /// The factor on a grain's spin that the rolling laws see on a flat wall, for grain
+    /// radius `r` (m) at overlap `dn` (m): grainlab's own (`Radius`) 1, as for a pair;
+    /// LIGGGHTS 3.8 `(r - dn/2)/(r - dn)` (the contact radius over the distance to the
+    /// wall: its `wr` of a wall contact, which EPSD2 integrates).
+    #[inline(always)]
+    pub fn wall_rolling(self, r: f64, dn: f64) -> f64 {
+        match self {
+            LeverArm::RadiusMinusHalfOverlap => (r - 0.5 * dn) / (r - dn),
+            _ => 1.0,
+        }
+    }
     /// Factor on the translational part of the tangential velocity of a pair.
     #[inline(always)]
     pub fn translation_scale<R: Real>(self, radsum: R, dn: R) -> R {
@@ -101,6 +113,11 @@ pub struct ContactInput<R: Real = f64> {
     /// Factor on the translational part of the tangential velocity (1, except for YADE's
     /// ratcheting correction, [`LeverArm::translation_scale`]).
     pub tangential_scale: R,
+    /// Relative spin w_i - w_j, rad/s (0 unless a rolling resistance reads it).
+    pub roll: R,
+    /// The rolling laws' factor on `roll` (1, except on LIGGGHTS' flat walls:
+    /// [`LeverArm::wall_rolling`]).
+    pub roll_scale: R,
 }
 
 impl<R: Real> ContactInput<R> {
@@ -128,6 +145,10 @@ pub struct ContactState<R: Real = f64> {
     pub kt: R,
     /// Relative velocity of the contact points, m/s.
     pub vc: Vector2<R>,
+    /// Rolling torque on i (j gets the opposite), N m; 0 without rolling resistance.
+    pub rolling: R,
+    /// The relative spin it acted against, w_i - w_j, rad/s (for the energy ledger).
+    pub roll: R,
 }
 
 /// The force of one contact on grain i (grain j gets the opposite).
@@ -141,6 +162,8 @@ pub struct ContactForce {
     pub normal: f64,
     /// Normal stiffness kn, N/m (for diagnostics).
     pub kn: f64,
+    /// Rolling torque on i, N m (0 without rolling resistance).
+    pub rolling: f64,
 }
 
 /// What a contact remembers from step to step. Whether it is touching is kept beside
@@ -150,8 +173,9 @@ pub struct ContactForce {
 /// ledger on: the force kernel reads and writes the tangential state alone.)
 #[derive(Clone, Copy, Debug, Default)]
 pub struct ContactHistory<H> {
-    /// The tangential formulation's state.
-    pub tangential: H,
+    /// The contact law's state ([`Held`]: the tangential formulation's and the rolling
+    /// resistance's).
+    pub state: H,
     /// What the energy accounting carries over.
     pub energy: EnergyMemory,
 }
@@ -164,6 +188,8 @@ pub struct ContactHistory<H> {
 pub struct EnergyMemory<R: Real = f64> {
     /// Previous normal damping force (for the trapezoidal energy integrals), N.
     pub fd_prev: R,
+    /// Previous rolling torque, N m.
+    pub mr_prev: R,
     /// Previous elastic tangential force, N.
     pub fte_prev: Vector2<R>,
     /// Previous tangential damping force, N.
@@ -174,18 +200,20 @@ pub struct EnergyMemory<R: Real = f64> {
 
 impl EnergyMemory<crate::physics::lanes::Lanes> {
     /// Four contacts' memories in lanes; with `friction` false only what a frictionless
-    /// contact uses (the normal damping's previous force and sum), the rest 0.
+    /// contact uses (the normal damping's previous force and sum), the rest 0; with
+    /// `rolling` false, the rolling torque's terms 0.
     #[inline(always)]
-    pub fn gather(h: [&EnergyMemory; crate::physics::lanes::LANES], friction: bool) -> Self {
+    pub fn gather(h: [&EnergyMemory; crate::physics::lanes::LANES], friction: bool, rolling: bool) -> Self {
         use crate::physics::lanes::{Lanes, gather, gather2};
         use simba::simd::SimdValue;
         if !friction {
             let z = Lanes::splat(0.0);
-            let sums = EnergySums { normal_damping: gather(|l| h[l].sums.normal_damping), tangential_damping: z, friction: z, tangential_model: z };
-            return EnergyMemory { fd_prev: gather(|l| h[l].fd_prev), fte_prev: Vector2::new(z, z), ftd_prev: Vector2::new(z, z), sums };
+            let sums = EnergySums { normal_damping: gather(|l| h[l].sums.normal_damping), tangential_damping: z, friction: z, tangential_model: z, rolling: z };
+            return EnergyMemory { fd_prev: gather(|l| h[l].fd_prev), mr_prev: z, fte_prev: Vector2::new(z, z), ftd_prev: Vector2::new(z, z), sums };
         }
         EnergyMemory {
             fd_prev: gather(|l| h[l].fd_prev),
+            mr_prev: if rolling { gather(|l| h[l].mr_prev) } else { Lanes::splat(0.0) },
             fte_prev: gather2(|l| h[l].fte_prev),
             ftd_prev: gather2(|l| h[l].ftd_prev),
             sums: EnergySums {
@@ -193,6 +221,7 @@ impl EnergyMemory<crate::physics::lanes::Lanes> {
                 tangential_damping: gather(|l| h[l].sums.tangential_damping),
                 friction: gather(|l| h[l].sums.friction),
                 tangential_model: gather(|l| h[l].sums.tangential_model),
+                rolling: if rolling { gather(|l| h[l].sums.rolling) } else { Lanes::splat(0.0) },
             },
         }
     }
@@ -216,18 +245,23 @@ impl EnergyMemory<crate::physics::lanes::Lanes> {
         let s = &self.sums;
         EnergyMemory {
             fd_prev: self.fd_prev.extract(l),
+            mr_prev: self.mr_prev.extract(l),
             fte_prev: lane2(&self.fte_prev, l),
             ftd_prev: lane2(&self.ftd_prev, l),
-            sums: EnergySums { normal_damping: s.normal_damping.extract(l), tangential_damping: s.tangential_damping.extract(l), friction: s.friction.extract(l), tangential_model: s.tangential_model.extract(l) },
+            sums: EnergySums { normal_damping: s.normal_damping.extract(l), tangential_damping: s.tangential_damping.extract(l), friction: s.friction.extract(l), tangential_model: s.tangential_model.extract(l), rolling: s.rolling.extract(l) },
         }
     }
 }
+
+/// A contact's state of law `L` as a checkpoint stores it.
+pub type Saved<L> = (<<L as ContactLaw>::Tang as Tangential>::Saved, <<L as ContactLaw>::Roll as Rolling>::Saved);
 
 /// A contact law: the trait the stages are generic over.
 pub trait ContactLaw: Copy + Send + Sync + 'static {
     type Damp: Damping;
     type Tang: Tangential;
     type Coh: Cohesion;
+    type Roll: Rolling;
     fn options(&self) -> ModelOptions;
     /// The elastic energies, normal and tangential (J), a touching contact of materials
     /// `pm`, reduced radius `r_star` (m) and square root of the reduced mass
@@ -236,15 +270,25 @@ pub trait ContactLaw: Copy + Send + Sync + 'static {
     fn stored_energy(&self, pm: &PairMaterial, r_star: f64, sqrt_m_star: f64, dn: f64, fte: Vec2) -> (f64, f64);
     /// The normal law's name and parameters, for `explain` and checkpoints.
     fn normal_label(&self) -> String;
+    /// The rolling resistance's name and parameters ("" without).
+    fn rolling_label(&self) -> String;
+    /// A contact's state as a checkpoint stores it (the same numbers), and back.
+    fn save_state(h: Held<Self::Tang, Self::Roll>) -> Saved<Self> {
+        (Self::Tang::save(h.0), Self::Roll::save(h.1))
+    }
+    fn load_state(s: Saved<Self>) -> Held<Self::Tang, Self::Roll> {
+        (Self::Tang::load(s.0), Self::Roll::load(s.1))
+    }
     /// One line for `explain`.
     fn describe(&self) -> String {
         let o = self.options();
         format!(
-            "Contacts<{}, {}, {}{}{}{}>",
+            "Contacts<{}, {}, {}{}{}{}{}>",
             self.normal_label(),
             Self::Damp::NAME,
             Self::Tang::NAME,
             if Self::Coh::ON { format!(", {}", Self::Coh::NAME) } else { String::new() },
+            if Self::Roll::ON { format!(", {}", self.rolling_label()) } else { String::new() },
             if o.limit_force { ", clamp Fn>=0" } else { "" },
             match (Self::Tang::FRICTION, o.lever_arm) {
                 (true, LeverArm::RadiusMinusHalfOverlap) => ", arm r-dn/2",
@@ -255,26 +299,51 @@ pub trait ContactLaw: Copy + Send + Sync + 'static {
     }
 }
 
+/// What a contact of tangential formulation `T` and rolling resistance `Rr` carries
+/// from step to step (one per lane with `R = Lanes`): their two states. Without rolling
+/// resistance the second is `()`, which takes no room.
+pub type Held<T, Rr, R = f64> = (<T as Tangential>::History<R>, <Rr as Rolling>::History<R>);
+
 /// A contact model, composed from a normal law, a damping form, a tangential
-/// formulation and a cohesion model (none unless a scene's materials ask for it).
+/// formulation, a cohesion model and a rolling resistance (none of the last two unless a
+/// scene asks for them).
 #[derive(Clone, Copy, Debug)]
-pub struct ContactModel<N: Normal, Dm: Damping, T: Tangential, C: Cohesion = NoCohesion> {
+pub struct ContactModel<N: Normal, Dm: Damping, T: Tangential, C: Cohesion = NoCohesion, Rr: Rolling = NoRolling> {
     pub options: ModelOptions,
     /// The normal law and its parameters (nothing for Hertz).
     pub normal: N,
+    /// The rolling resistance and its parameters (nothing for most).
+    pub rolling: Rr,
     _p: PhantomData<(Dm, T, C)>,
 }
 
-impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion> ContactModel<N, Dm, T, C> {
+impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling + Default> ContactModel<N, Dm, T, C, Rr> {
     pub fn new(options: ModelOptions, normal: N) -> Self {
-        ContactModel { options, normal, _p: PhantomData }
+        Self::with_rolling(options, normal, Rr::default())
+    }
+}
+
+impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling> ContactModel<N, Dm, T, C, Rr> {
+    /// A model whose rolling resistance has parameters.
+    pub fn with_rolling(options: ModelOptions, normal: N, rolling: Rr) -> Self {
+        ContactModel { options, normal, rolling, _p: PhantomData }
+    }
+
+    /// Four contacts' states in lanes, and one lane of them.
+    #[inline(always)]
+    pub fn gather(h: [&Held<T, Rr>; crate::physics::lanes::LANES]) -> Held<T, Rr, crate::physics::lanes::Lanes> {
+        (T::gather(h.map(|x| &x.0)), Rr::gather(h.map(|x| &x.1)))
+    }
+    #[inline(always)]
+    pub fn lane(h: &Held<T, Rr, crate::physics::lanes::Lanes>, l: usize) -> Held<T, Rr> {
+        (T::lane(&h.0, l), Rr::lane(&h.1, l))
     }
 
     /// The force of a touching contact (of four, one per lane, with `R = Lanes`),
     /// advancing its tangential state. No branch on the data: the same bits per lane as
     /// for the contact alone.
     #[inline(always)]
-    pub fn force<R: Real>(&self, c: &ContactInput<R>, pm: &PairMaterial<R>, h: &mut T::History<R>) -> ContactState<R> {
+    pub fn force<R: Real>(&self, c: &ContactInput<R>, pm: &PairMaterial<R>, h: &mut Held<T, Rr, R>) -> ContactState<R> {
         let st = self.normal.stiffness(pm, c.r_star, c.sqrt_m_star, c.dn);
         let (gn, gt) = Dm::coefficients(pm, c.sqrt_m_star, &st);
         let vc = c.contact_velocity();
@@ -300,10 +369,16 @@ impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion> ContactModel<N, Dm, T, 
                 vt += (c.v_rel - c.n * c.v_rel.dot(&c.n)) * (c.tangential_scale - R::one());
             }
             let inp = TangentialInput { n: c.n, vt, kt: st.kt, gt, cap: pm.friction * cap_force.simd_abs(), dt: c.dt };
-            tf = T::force(h, &inp);
+            tf = T::force(&mut h.0, &inp);
         }
         force += tf.elastic + tf.damping;
-        ContactState { force, tangential: tf, normal: fnorm, elastic_normal: elastic_n, kn: st.kn, kt: st.kt, vc }
+        let rolling = if Rr::ON {
+            let inp = RollingInput { w: c.roll * c.roll_scale, r_star: c.r_star, kt: st.kt, elastic_normal: st.kn * c.dn, normal: fnorm, mu: pm.rolling_friction, dt: c.dt };
+            self.rolling.torque(&mut h.1, &inp)
+        } else {
+            R::zero()
+        };
+        ContactState { force, tangential: tf, normal: fnorm, elastic_normal: elastic_n, kn: st.kn, kt: st.kt, vc, rolling, roll: c.roll }
     }
 
     /// The force of a touching contact, updating its history; with `ENERGY`, this
@@ -314,10 +389,10 @@ impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion> ContactModel<N, Dm, T, 
         &self,
         c: &ContactInput,
         pm: &PairMaterial,
-        h: &mut ContactHistory<T::History<f64>>,
+        h: &mut ContactHistory<Held<T, Rr>>,
         ledger: &mut EnergyLedger,
     ) -> ContactForce {
-        let s = self.force(c, pm, &mut h.tangential);
+        let s = self.force(c, pm, &mut h.state);
         if ENERGY {
             self.energy_step(c.n, c.dt, &s, &mut h.energy);
             ledger.add(&std::mem::take(&mut h.energy.sums));
@@ -327,7 +402,7 @@ impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion> ContactModel<N, Dm, T, 
             ledger.elastic_tangential += ut;
         }
         let tf = s.tangential;
-        ContactForce { force: s.force, tangential: tf.elastic + tf.damping, normal: s.normal, kn: s.kn }
+        ContactForce { force: s.force, tangential: tf.elastic + tf.damping, normal: s.normal, kn: s.kn, rolling: s.rolling }
     }
 
     /// One step of a touching contact (of four, in lanes) in its energy memory `h`, from
@@ -348,6 +423,11 @@ impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion> ContactModel<N, Dm, T, 
             h.fte_prev = tf.elastic;
             h.ftd_prev = tf.damping;
         }
+        if Rr::ON {
+            // The rolling torques' work on the two grains, M (w_i - w_j) dt.
+            h.sums.rolling -= k::<R>(0.5) * (h.mr_prev + s.rolling) * s.roll * dt;
+            h.mr_prev = s.rolling;
+        }
     }
 
     /// The elastic energies, normal and tangential (J), a touching contact of stiffnesses
@@ -363,16 +443,20 @@ impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion> ContactModel<N, Dm, T, 
 
     /// A contact that was touching at the previous step and is not any more: close its
     /// energy integrals into its sums (the force fell to zero over this step) and forget
-    /// its history: the tangential state `t` and (with `ENERGY`) the previous-step values
-    /// in `h`. The sums stay, for the ledger to take.
+    /// its history: the law's state `t` and (with `ENERGY`) the previous-step values in
+    /// `h` (`roll`: the relative spin w_i - w_j, rad/s, for the rolling torque's work). The sums stay, for the ledger to take.
     #[inline(always)]
-    pub fn release<const ENERGY: bool>(&self, c_velocity: Vec2, n: Vec2, dt: f64, t: &mut T::History<f64>, h: &mut EnergyMemory) {
+    #[allow(clippy::too_many_arguments)]
+    pub fn release<const ENERGY: bool>(&self, c_velocity: Vec2, n: Vec2, roll: f64, dt: f64, t: &mut Held<T, Rr>, h: &mut EnergyMemory) {
         if ENERGY {
             let dc = c_velocity * dt;
             h.sums.normal_damping -= 0.5 * h.fd_prev * dc.dot(&n);
             if T::FRICTION {
                 h.sums.tangential_damping -= 0.5 * h.ftd_prev.dot(&dc);
                 h.sums.tangential_model += 0.5 * h.fte_prev.dot(&dc);
+            }
+            if Rr::ON {
+                h.sums.rolling -= 0.5 * h.mr_prev * roll * dt;
             }
         }
         *t = Default::default();
@@ -382,10 +466,11 @@ impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion> ContactModel<N, Dm, T, 
     }
 }
 
-impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion> ContactLaw for ContactModel<N, Dm, T, C> {
+impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling> ContactLaw for ContactModel<N, Dm, T, C, Rr> {
     type Damp = Dm;
     type Tang = T;
     type Coh = C;
+    type Roll = Rr;
     fn options(&self) -> ModelOptions {
         self.options
     }
@@ -396,6 +481,9 @@ impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion> ContactLaw for ContactM
     }
     fn normal_label(&self) -> String {
         self.normal.label()
+    }
+    fn rolling_label(&self) -> String {
+        if Rr::ON { self.rolling.label() } else { String::new() }
     }
 }
 
@@ -434,5 +522,15 @@ pub type HertzDmtHistory = ContactModel<Hertz, Viscoelastic, TotalDisplacement, 
 pub type HookeDmtFrictionless = ContactModel<Hooke, LinearRestitution, Frictionless, Dmt>;
 pub type HookeDmtHistory = ContactModel<Hooke, LinearRestitution, TotalDisplacement, Dmt>;
 
+/// Rolling resistance (`model.rolling`) with either normal law, its restitution damping
+/// and the total-displacement history: LIGGGHTS `rolling_friction cdt` and `epsd2`,
+/// LAMMPS `rolling sds`.
+pub type HertzHistoryCdt = ContactModel<Hertz, Viscoelastic, TotalDisplacement, NoCohesion, Cdt>;
+pub type HertzHistoryEpsd2 = ContactModel<Hertz, Viscoelastic, TotalDisplacement, NoCohesion, Epsd2>;
+pub type HertzHistorySds = ContactModel<Hertz, Viscoelastic, TotalDisplacement, NoCohesion, Sds>;
+pub type HookeHistoryCdt = ContactModel<Hooke, LinearRestitution, TotalDisplacement, NoCohesion, Cdt>;
+pub type HookeHistoryEpsd2 = ContactModel<Hooke, LinearRestitution, TotalDisplacement, NoCohesion, Epsd2>;
+pub type HookeHistorySds = ContactModel<Hooke, LinearRestitution, TotalDisplacement, NoCohesion, Sds>;
+
 /// The names of the compiled combinations, for a refusal.
-pub const COMPILED: &str = "normal hertz or hooke (hooke_stiffness), each with damping (beta(e); the linear spring's constant-restitution form) or none (every e = 1), and tangential total_displacement, incremental_force or frictionless; damping tsuji with either normal law, total_displacement or frictionless; cohesion (work_of_adhesion > 0) with either normal law, the restitution damping, total_displacement or frictionless, without limit_force";
+pub const COMPILED: &str = "normal hertz or hooke (hooke_stiffness), each with damping (beta(e); the linear spring's constant-restitution form) or none (every e = 1), and tangential total_displacement, incremental_force or frictionless; damping tsuji with either normal law, total_displacement or frictionless; cohesion (work_of_adhesion > 0) with either normal law, the restitution damping, total_displacement or frictionless, without limit_force; rolling (cdt, epsd2, sds) with either normal law, the restitution damping and total_displacement, without cohesion";

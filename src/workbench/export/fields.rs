@@ -196,6 +196,12 @@ pub const FIELDS: &[Field] = &[
             .or_differs("above 0 with friction", "LAMMPS 20220106's DMT friction cap mu |Fne + 2 F_pulloff| takes F_pulloff = 4 pi coh R* from a variable its DMT branch never sets (only JKR's does): measured on one grain sliding on a wall/gran plane and on a pair, the cap is mu |Fne + 8 pi 1e-6 R*| whatever the input cohesion, instead of grainlab's (and later LAMMPS releases') mu |Fn + 2 F0|; frictional DMT contacts differ"),
     ),
     each(
+        "materials[].rolling_friction",
+        written("`fix m9 ... coefficientRollingFriction peratomtypepair`, each pair the smaller mu_r (with model.rolling cdt or epsd2)"),
+        outside("read only with model.rolling other than none, which the YADE export refuses"),
+    )
+    .in_lammps(written("each pair of types' `rolling sds K G MU_R`, MU_R the pair's smaller mu_r (with model.rolling sds)")),
+    each(
         "domain.periodic_x",
         written("`boundary p f f` and the box's x bounds in grains.data"),
         written("a periodic cell of length L from x_min (y and z 10x the packing: YADE cells are periodic in every direction)")
@@ -334,6 +340,25 @@ pub const FIELDS: &[Field] = &[
         differs("radius, radius_minus_half_overlap", "YADE's ScGeom kinematics are lever_arm yade (full radii for the spins in the contact velocity, its translational part scaled by (r1 + r2) / (r1 + r2 - dn), torque arm r - dn/2, r - dn on a wall); torques and tangential velocities differ by O(dn/r)"),
     )
     .in_lammps(differs("radius, radius_minus_half_overlap, yade", "LAMMPS' arms are r in the contact velocity and r - dn/2 in the torque between grains, r in both on a wall/gran plane: lever_arm radius for a grain on a flat wall, no grainlab variant for grain pairs; torques and tangential velocities of frictional grain pairs differ by O(dn/r)")),
+    each(
+        "model.rolling",
+        written("cdt, epsd2: `rolling_friction cdt` or `rolling_friction epsd2` in the pair style and the wall/gran fixes (LIGGGHTS scales a grain's spin on a wall by (r - dn/2)/(r - dn) for EPSD2, which grainlab does with lever_arm radius_minus_half_overlap)")
+            .or_refused("sds: LIGGGHTS 3.8 has cdt, epsd, epsd2 and epsd3, no spring-dashpot-slider on a rolling displacement"),
+        written("none: no rolling torque, as YADE's Mindlin law").or_refused("cdt, epsd2, sds: YADE 2023's Mindlin law has no rolling resistance (its rolling moments belong to CohFrictMat's law)"),
+    )
+    .in_lammps(written("sds: `rolling sds K G MU_R` in every pair_coeff and wall/gran fix (a grain on a wall: R* = r, as grainlab)").or_refused("cdt, epsd2: LAMMPS 20220106's pair granular has rolling sds only")),
+    each(
+        "model.rolling.sds.stiffness",
+        outside("read only with model.rolling = sds, which the LIGGGHTS export refuses"),
+        outside("read only with model.rolling = sds, which the YADE export refuses"),
+    )
+    .in_lammps(written("`rolling sds K ...`: K, N/m")),
+    each(
+        "model.rolling.sds.damping",
+        outside("read only with model.rolling = sds, which the LIGGGHTS export refuses"),
+        outside("read only with model.rolling = sds, which the YADE export refuses"),
+    )
+    .in_lammps(written("`rolling sds K G ...`: G, kg/s (LAMMPS' gamma_roll, not scaled by the normal damping)")),
     each(
         "model.rotation",
         written("false: `fix nve` for the free grains instead of `nve/sphere`"),

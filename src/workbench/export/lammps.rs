@@ -193,7 +193,12 @@ fn words(scene: &Scene, pm: &PairMaterial, kns: &[f64], what: &str) -> Result<St
     // wall: with NU = 0 and E = 2 E* both are KN; its attraction 4 pi GAMMA R* is
     // grainlab's 2 pi w R* with GAMMA = w/2.
     let normal = if pm.pulloff > 0.0 { format!("dmt {} {} 0 {}", f(2.0 * pm.e_star), f(d), f(pm.work_of_adhesion() / 2.0)) } else { format!("{} {} {}", normal.0, f(normal.1), f(d)) };
-    Ok(format!("{normal} tangential {tangential} {} {} {} damping {damping}{limit}", f(kt), f(ratio), f(mu)))
+    // (prepare refused CDT and EPSD2)
+    let rolling = match model.rolling {
+        crate::scene::RollingSpec::Sds { stiffness, damping } => format!(" rolling sds {} {} {}", f(stiffness), f(damping), f(pm.rolling_friction)),
+        _ => String::new(),
+    };
+    Ok(format!("{normal} tangential {tangential} {} {} {} damping {damping}{limit}{rolling}", f(kt), f(ratio), f(mu)))
 }
 
 /// `pair_style granular` and a `pair_coeff` for every pair of atom types.

@@ -204,7 +204,16 @@ fn materials(w: &mut String, scene: &Scene, ex: &Exported) -> Result<String, Err
             "hooke/stiffness"
         }
     };
-    let law = format!("model {style} tangential history{}", if model.limit_force { " limitForce on" } else { "" });
+    let rolling = match model.rolling {
+        crate::scene::RollingSpec::Cdt => " rolling_friction cdt",
+        crate::scene::RollingSpec::Epsd2 => " rolling_friction epsd2",
+        // (prepare refused SDS)
+        _ => "",
+    };
+    if !rolling.is_empty() {
+        let _ = writeln!(w, "fix m9 all property/global coefficientRollingFriction peratomtypepair {n} {}", pair(&|pm| pm.rolling_friction));
+    }
+    let law = format!("model {style} tangential history{rolling}{}", if model.limit_force { " limitForce on" } else { "" });
     let _ = writeln!(w, "pair_style gran {law}\npair_coeff * *");
     Ok(law)
 }

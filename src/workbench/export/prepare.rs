@@ -37,6 +37,22 @@ pub(crate) fn prepare(scene: &Scene, code: Code, limits: &crate::scene::limits::
     {
         return Err(fields::refuse(code, &format!("materials[{k}].work_of_adhesion"), m.work_of_adhesion, if code == Code::Lammps { "model.normal = hooke" } else { "" }));
     }
+    // Rolling resistance: LIGGGHTS has CDT and EPSD2, LAMMPS SDS, YADE none.
+    let rolling = scene.model.rolling;
+    let has = match rolling {
+        crate::scene::RollingSpec::None => true,
+        crate::scene::RollingSpec::Cdt | crate::scene::RollingSpec::Epsd2 => code == Code::Liggghts,
+        crate::scene::RollingSpec::Sds { .. } => code == Code::Lammps,
+    };
+    if !has {
+        // The law's name alone: its parameters change nothing about the refusal.
+        let name = match rolling {
+            crate::scene::RollingSpec::Cdt => "\"cdt\"",
+            crate::scene::RollingSpec::Epsd2 => "\"epsd2\"",
+            _ => "\"sds\"",
+        };
+        return Err(fields::refuse(code, "model.rolling", name, ""));
+    }
     if let Some(c) = scene.model.general_damping {
         return Err(fields::refuse(code, "model.general_damping", c, ""));
     }
