@@ -106,6 +106,7 @@ pub fn cases() -> Vec<Case> {
     lammps_cases(&mut out);
     linear_spring_cases(&mut out);
     chung_ooi_cases(&mut out);
+    rolling_cases(&mut out);
     let mut s = builtin::shear();
     s.model.lever_arm = LeverArm::RadiusMinusHalfOverlap;
     s.name = "shear-liggghts".into();
@@ -181,6 +182,48 @@ fn lammps_cases(out: &mut Vec<Case>) {
     }
     tsuji_cases(out);
     dmt_cases(out);
+}
+
+/// The rolling friction coefficient of the `rolling/*` cases: with mu = 0.5 the rolling
+/// torque's cap mu_r R* |Fn| is a fifth of the friction's torque r mu |Fn| on a wall, a
+/// tenth on a pair of equal grains.
+pub const ROLLING_FRICTION: f64 = 0.1;
+
+/// Rolling resistance against the codes that have it: LIGGGHTS' CDT and EPSD2 on oblique
+/// impacts (1 m/s, 30 and 60 degrees, e = 0.9, mu = 0.5, LIGGGHTS' lever arm r - dn/2)
+/// on a flat wall and on a resting grain (the incoming grain spinning), and LAMMPS' SDS on a flat wall (e = 1 and
+/// lever arm r, where LAMMPS' tangential law is grainlab's: `oblique-wall/lammps`),
+/// undamped and damped. t_c/200. `rolling/...`.
+fn rolling_cases(out: &mut Vec<Case>) {
+    use crate::scene::RollingSpec;
+    let resisting = |e: f64| Material { rolling_friction: ROLLING_FRICTION, ..glass(e) };
+    type Oblique = fn(Material, f64, f64, f64, TangentialSpec, f64) -> Scene;
+    for (law, tag) in [(RollingSpec::Cdt, "cdt"), (RollingSpec::Epsd2, "epsd2")] {
+        for (target, builder, what) in [("wall", builtin::oblique as Oblique, "a flat glass wall"), ("pair", builtin::oblique_pair, "a resting one")] {
+            for a in [30.0, 60.0] {
+                let mut s = builder(resisting(0.9), 1e-3, 1.0, a, TangentialSpec::TotalDisplacement, 200.0);
+                // Two equal grains pick up equal spins from their contact, which roll
+                // nothing: the incoming one spins at 200 rad/s (w r = 0.2 m/s).
+                if let (true, crate::scene::Grains::List(list)) = (target == "pair", &mut s.grains) {
+                    list[0].omega = 200.0;
+                }
+                s.model.rolling = law;
+                s.model.lever_arm = LeverArm::RadiusMinusHalfOverlap;
+                let spin = if target == "pair" { "spinning at 200 rad/s, " } else { "" };
+                s.description = format!("glass bead on {what} at 1 m/s, {a} deg, e = 0.9, mu = 0.5, {spin}rolling resistance {tag} (LIGGGHTS), mu_r = {ROLLING_FRICTION}, lever arm r - dn/2, t_c/200");
+                out.push(Case::new(format!("rolling/{tag}-{target}-a{}", num(a)), s, vec![Code::Liggghts], a == 30.0));
+            }
+        }
+    }
+    for (g, tag) in [(0.0, "sds"), (1e-3, "sds-damped")] {
+        for a in [30.0, 60.0] {
+            let mut s = builtin::oblique(resisting(1.0), 1e-3, 1.0, a, TangentialSpec::TotalDisplacement, 200.0);
+            s.model.rolling = RollingSpec::Sds { stiffness: 1e5, damping: g };
+            s.model.lever_arm = LeverArm::Radius;
+            s.description = format!("glass bead on a flat glass wall at 1 m/s, {a} deg, e = 1, mu = 0.5, rolling resistance SDS (LAMMPS) k = 1e5 N/m, g = {g} kg/s, mu_r = {ROLLING_FRICTION}, lever arm r, t_c/200");
+            out.push(Case::new(format!("rolling/{tag}-wall-a{}", num(a)), s, vec![Code::Lammps], a == 30.0));
+        }
+    }
 }
 
 /// The work of adhesion of the `dmt/*` cases, J/m^2: with 1 mm glass beads a pull-off

@@ -188,7 +188,7 @@ pub fn compare_case(case_dir: &Path) -> Result<Vec<Row>, Error> {
                 (engine_impact(&scene)?, None)
             };
             // Tangential outcomes too where the impact has a tangential part.
-            let oblique = case.name.contains("oblique") || case.name.starts_with("chung-ooi");
+            let oblique = case.name.contains("oblique") || case.name.starts_with("chung-ooi") || case.name.starts_with("rolling/");
             for code in codes {
                 rows.extend(compare_impact(&case.name, code, &e, &expected_impact(case_dir, code)?, oblique));
                 // The force-overlap curve on a common normalised grid (50 overlaps per
