@@ -144,6 +144,20 @@ fn bases(dir: &Path) -> Vec<Value> {
     dmt_pair["materials"][0]["work_of_adhesion"] = json!(1.0);
     dmt_pair["model"]["normal"] = json!({"hooke_stiffness": {"kn": 2e5, "kt": 1.5e5}});
     out.push(dmt_pair);
+    // Rolling resistance: EPSD2 in the loaded shear cell, SDS on an oblique pair under the
+    // given spring.
+    let mut rolling = json(&shear);
+    rolling["model"]["rolling"] = "epsd2".into();
+    for m in rolling["materials"].as_array_mut().unwrap() {
+        m["rolling_friction"] = json!(0.1);
+    }
+    out.push(rolling);
+    let mut rolling_pair = json(&builtin::oblique_pair(grainlab::physics::material::Material::default(), 1e-3, 1.0, 30.0, grainlab::scene::TangentialSpec::TotalDisplacement, 50.0));
+    rolling_pair["model"]["normal"] = json!({"hooke_stiffness": {"kn": 2e5, "kt": 1.5e5}});
+    rolling_pair["model"]["rolling"] = json!({"sds": {"stiffness": 1e5, "damping": 1e-3}});
+    rolling_pair["materials"][0]["rolling_friction"] = json!(0.2);
+    rolling_pair["grains"]["list"][0]["omega"] = json!(300.0);
+    out.push(rolling_pair);
     out
 }
 

@@ -434,7 +434,7 @@ impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling, const ENER
                 cross_out.clear();
                 cross_out.resize(slots.len(), PairOut::default());
                 {
-                    let list = PairSlices::<T> { pairs: checked.part(part.clone()), consts: &consts[part.clone()], hist: &mut *hist, energy: &mut *energy, active: &mut *active };
+                    let list = PairSlices::<T, Rr> { pairs: checked.part(part.clone()), consts: &consts[part.clone()], hist: &mut *hist, energy: &mut *energy, active: &mut *active };
                     // Touching pairs come in list order, as the slots are.
                     let mut slot = 0;
                     let sink = |k: usize, _, o: PairOut| {
@@ -467,7 +467,7 @@ impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling, const ENER
                 // (4) Our pairs, each force to its grains as the kernel hands it over; a rough
                 // wall's grain belongs to the first thread, so the others keep what they do
                 // to one for it, in list order.
-                let list = PairSlices::<T> { pairs: checked.part(part.clone()), consts: &consts[part.clone()], hist, energy, active };
+                let list = PairSlices::<T, Rr> { pairs: checked.part(part.clone()), consts: &consts[part.clone()], hist, energy, active };
                 wall_out.clear();
                 wall_first.clear();
                 let mut add = |(i, j): (usize, usize), o: &PairOut, own: bool| {

@@ -224,6 +224,22 @@ fn rolling_cases(out: &mut Vec<Case>) {
             out.push(Case::new(format!("rolling/{tag}-wall-a{}", num(a)), s, vec![Code::Lammps], a == 30.0));
         }
     }
+    // The shear cell with EPSD2 (LIGGGHTS' lever arm) and with SDS (as shear/lammps: lever
+    // arm r, LAMMPS' own tangential history differing by O(dn/r)): time averages within
+    // the combined interval.
+    for (law, tag, code) in [(RollingSpec::Epsd2, "liggghts", Code::Liggghts), (RollingSpec::Sds { stiffness: 1e5, damping: 0.0 }, "lammps", Code::Lammps)] {
+        let mut s = builtin::shear();
+        s.model.rolling = law;
+        for m in &mut s.materials {
+            m.rolling_friction = ROLLING_FRICTION;
+        }
+        if code == Code::Liggghts {
+            s.model.lever_arm = LeverArm::RadiusMinusHalfOverlap;
+        }
+        s.description = format!("the shear cell (built-in `shear`) with rolling resistance {} (mu_r = {ROLLING_FRICTION}), {}", if code == Code::Liggghts { "EPSD2 and LIGGGHTS' lever arm" } else { "SDS, k = 1e5 N/m, and lever arm r" }, code.name());
+        s.output.frames = 0;
+        out.push(Case::new(format!("rolling-shear/{tag}"), s, vec![code], false));
+    }
 }
 
 /// The work of adhesion of the `dmt/*` cases, J/m^2: with 1 mm glass beads a pull-off
