@@ -5,7 +5,7 @@ use grainlab::physics::boundary::Boundary;
 use grainlab::physics::dim::Vec2;
 use grainlab::kernels::cells::{brute_force_pairs, cell_pairs};
 use grainlab::kernels::threads::Threads;
-use grainlab::physics::contact::rolling::{NoRolling, Rolling};
+use grainlab::physics::contact::rolling::{NoRolling, Rolling, RollingEnergy};
 use proptest::prelude::*;
 
 fn packing() -> impl Strategy<Value = (Vec<Vec2>, Vec<f64>, usize, bool, f64)> {
@@ -76,6 +76,8 @@ fn lanes_match_alone<N: grainlab::physics::contact::normal::Normal, D: grainlab:
     bits: impl Fn(&T::History<f64>) -> Vec<u64>,
     rhist: impl Fn(&[f64; 9]) -> Rr::History<f64>,
     rbits: impl Fn(&Rr::History<f64>) -> Vec<u64>,
+    rmem: impl Fn(&[f64; 9]) -> Rr::Energy,
+    rmem_bits: impl Fn(&Rr::Energy) -> Vec<u64>,
 ) -> Result<(), TestCaseError> {
     use grainlab::physics::contact::{ContactInput, ContactModel, ModelOptions};
     use grainlab::physics::lanes::{Lanes, gather, gather2, lane2};
@@ -131,24 +133,26 @@ fn lanes_match_alone<N: grainlab::physics::contact::normal::Normal, D: grainlab:
     // likewise.
     use grainlab::physics::contact::EnergyMemory;
     use grainlab::physics::energy::EnergySums;
-    let memory = |c: &[f64; 9]| EnergyMemory {
+    let memory = |c: &[f64; 9]| EnergyMemory::<f64, Rr::Energy> {
         fd_prev: c[2],
-        mr_prev: 1e-6 * c[5],
         fte_prev: Vec2::new(c[5], c[6]) * 1e3,
         ftd_prev: Vec2::new(c[3], c[4]),
-        sums: EnergySums { normal_damping: 1e-9 * c[8], tangential_damping: 1e-9 * c[7], friction: 1e-9 * c[0].abs(), tangential_model: 1e-9 * c[1], rolling: 1e-9 * c[6] },
+        sums: EnergySums { normal_damping: 1e-9 * c[8], tangential_damping: 1e-9 * c[7], friction: 1e-9 * c[0].abs(), tangential_model: 1e-9 * c[1] },
+        rolling: rmem(c),
     };
-    let mem_bits = |m: &EnergyMemory| {
+    let mem_bits = |m: &EnergyMemory<f64, Rr::Energy>| {
         let s = &m.sums;
-        [m.fd_prev, m.mr_prev, m.fte_prev.x, m.fte_prev.y, m.ftd_prev.x, m.ftd_prev.y, s.normal_damping, s.tangential_damping, s.friction, s.tangential_model, s.rolling].map(f64::to_bits)
+        let r = &m.rolling;
+        let bits = [m.fd_prev, m.fte_prev.x, m.fte_prev.y, m.ftd_prev.x, m.ftd_prev.y, s.normal_damping, s.tangential_damping, s.friction, s.tangential_model, r.taken()].map(f64::to_bits).to_vec();
+        [bits, rmem_bits(r)].concat()
     };
     let mems: Vec<_> = cs.iter().map(memory).collect();
-    let mut m = EnergyMemory::gather([&mems[0], &mems[1], &mems[2], &mems[3]], true, true);
+    let mut m = M::<N, D, T, Rr>::gather_energy([&mems[0], &mems[1], &mems[2], &mems[3]], true);
     model.energy_step(lanes.n, lanes.dt, &s, &mut m);
     for l in 0..4 {
         let mut alone_m = mems[l];
         model.energy_step(one[l].n, one[l].dt, &alone[l].0, &mut alone_m);
-        prop_assert_eq!(mem_bits(&m.lane(l)), mem_bits(&alone_m), "lane {} energy memory", l);
+        prop_assert_eq!(mem_bits(&M::<N, D, T, Rr>::energy_lane(&m, l)), mem_bits(&alone_m), "lane {} energy memory", l);
     }
     Ok(())
 }
@@ -161,29 +165,31 @@ proptest! {
         use grainlab::physics::contact::tangential::{IncrementalForce, IncrementalState, TotalDisplacement};
         use grainlab::physics::contact::damping::{LinearRestitution, TsujiFit, Viscoelastic};
         use grainlab::physics::contact::normal::{Hertz, Hooke};
-        use grainlab::physics::contact::rolling::{Cdt, Epsd2, Sds};
+        use grainlab::physics::contact::rolling::{Cdt, Epsd2, RollingMemory, Sds};
         let lever = [LeverArm::Radius, LeverArm::RadiusMinusHalfOverlap, LeverArm::Yade][lever];
         let cs = [c0, c1, c2, c3];
         let v = |v: &Vec2| vec![v.x.to_bits(), v.y.to_bits()];
         let incremental = |c: &[f64; 9]| IncrementalState { force: Vec2::new(c[5], c[6]) * 1e3, n_prev: Vec2::new(c[7].cos(), c[7].sin()) };
         let incremental_bits = |h: &IncrementalState| [v(&h.force), v(&h.n_prev)].concat();
-        lanes_match_alone::<Hertz, Viscoelastic, TotalDisplacement, NoRolling>(Hertz, NoRolling, &cs, clamp, lever, |c| Vec2::new(c[5], c[6]), v, |_| (), |_| vec![])?;
-        lanes_match_alone::<Hertz, Viscoelastic, IncrementalForce, NoRolling>(Hertz, NoRolling, &cs, clamp, lever, incremental, incremental_bits, |_| (), |_| vec![])?;
+        lanes_match_alone::<Hertz, Viscoelastic, TotalDisplacement, NoRolling>(Hertz, NoRolling, &cs, clamp, lever, |c| Vec2::new(c[5], c[6]), v, |_| (), |_| vec![], |_| (), |_| vec![])?;
+        lanes_match_alone::<Hertz, Viscoelastic, IncrementalForce, NoRolling>(Hertz, NoRolling, &cs, clamp, lever, incremental, incremental_bits, |_| (), |_| vec![], |_| (), |_| vec![])?;
         // The linear spring, derived per pair (a fifth root lane by lane) and given.
         for spring in [Hooke::Derived { vc: 0.8 }, Hooke::Given { kn: 3e5, kt: 2e5 }] {
-            lanes_match_alone::<Hooke, LinearRestitution, TotalDisplacement, NoRolling>(spring, NoRolling, &cs, clamp, lever, |c| Vec2::new(c[5], c[6]), v, |_| (), |_| vec![])?;
-            lanes_match_alone::<Hooke, LinearRestitution, IncrementalForce, NoRolling>(spring, NoRolling, &cs, clamp, lever, incremental, incremental_bits, |_| (), |_| vec![])?;
-            lanes_match_alone::<Hooke, TsujiFit, TotalDisplacement, NoRolling>(spring, NoRolling, &cs, clamp, lever, |c| Vec2::new(c[5], c[6]), v, |_| (), |_| vec![])?;
+            lanes_match_alone::<Hooke, LinearRestitution, TotalDisplacement, NoRolling>(spring, NoRolling, &cs, clamp, lever, |c| Vec2::new(c[5], c[6]), v, |_| (), |_| vec![], |_| (), |_| vec![])?;
+            lanes_match_alone::<Hooke, LinearRestitution, IncrementalForce, NoRolling>(spring, NoRolling, &cs, clamp, lever, incremental, incremental_bits, |_| (), |_| vec![], |_| (), |_| vec![])?;
+            lanes_match_alone::<Hooke, TsujiFit, TotalDisplacement, NoRolling>(spring, NoRolling, &cs, clamp, lever, |c| Vec2::new(c[5], c[6]), v, |_| (), |_| vec![], |_| (), |_| vec![])?;
         }
         // Rolling resistance: the constant torque (a sign lane by lane), the torque
         // spring and LAMMPS' SDS, from states below and beyond their caps.
         let torque = |c: &[f64; 9]| 1e-6 * c[6] * 1e5;
         let roll_bits = |m: &f64| vec![m.to_bits()];
-        lanes_match_alone::<Hertz, Viscoelastic, TotalDisplacement, Cdt>(Hertz, Cdt, &cs, clamp, lever, |c| Vec2::new(c[5], c[6]), v, |_| (), |_| vec![])?;
-        lanes_match_alone::<Hertz, Viscoelastic, TotalDisplacement, Epsd2>(Hertz, Epsd2, &cs, clamp, lever, |c| Vec2::new(c[5], c[6]), v, torque, roll_bits)?;
-        lanes_match_alone::<Hertz, Viscoelastic, TotalDisplacement, Sds>(Hertz, Sds { k: 2e5, g: 0.01 }, &cs, clamp, lever, |c| Vec2::new(c[5], c[6]), v, |c| c[5], roll_bits)?;
-        lanes_match_alone::<Hooke, LinearRestitution, TotalDisplacement, Epsd2>(Hooke::Given { kn: 3e5, kt: 2e5 }, Epsd2, &cs, clamp, lever, |c| Vec2::new(c[5], c[6]), v, torque, roll_bits)?;
+        let roll_mem = |c: &[f64; 9]| RollingMemory { m_prev: 1e-6 * c[5], taken: 1e-9 * c[6] };
+        let roll_mem_bits = |m: &RollingMemory| vec![m.m_prev.to_bits(), m.taken.to_bits()];
+        lanes_match_alone::<Hertz, Viscoelastic, TotalDisplacement, Cdt>(Hertz, Cdt, &cs, clamp, lever, |c| Vec2::new(c[5], c[6]), v, |_| (), |_| vec![], roll_mem, roll_mem_bits)?;
+        lanes_match_alone::<Hertz, Viscoelastic, TotalDisplacement, Epsd2>(Hertz, Epsd2, &cs, clamp, lever, |c| Vec2::new(c[5], c[6]), v, torque, roll_bits, roll_mem, roll_mem_bits)?;
+        lanes_match_alone::<Hertz, Viscoelastic, TotalDisplacement, Sds>(Hertz, Sds { k: 2e5, g: 0.01 }, &cs, clamp, lever, |c| Vec2::new(c[5], c[6]), v, |c| c[5], roll_bits, roll_mem, roll_mem_bits)?;
+        lanes_match_alone::<Hooke, LinearRestitution, TotalDisplacement, Epsd2>(Hooke::Given { kn: 3e5, kt: 2e5 }, Epsd2, &cs, clamp, lever, |c| Vec2::new(c[5], c[6]), v, torque, roll_bits, roll_mem, roll_mem_bits)?;
         // LAMMPS' Tsuji damping (its polynomial of e lane by lane).
-        lanes_match_alone::<Hertz, TsujiFit, TotalDisplacement, NoRolling>(Hertz, NoRolling, &cs, clamp, lever, |c| Vec2::new(c[5], c[6]), v, |_| (), |_| vec![])?;
+        lanes_match_alone::<Hertz, TsujiFit, TotalDisplacement, NoRolling>(Hertz, NoRolling, &cs, clamp, lever, |c| Vec2::new(c[5], c[6]), v, |_| (), |_| vec![], |_| (), |_| vec![])?;
     }
 }

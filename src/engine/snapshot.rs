@@ -22,8 +22,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::engine::simulation::Simulation;
 use crate::engine::world::{PendingKick, State, Zeroed};
-use crate::physics::contact::model::Saved;
-use crate::physics::contact::{ContactHistory, ContactLaw, EnergyMemory};
+use crate::physics::contact::model::{Memory, Saved};
+use crate::physics::contact::{ContactHistory, ContactLaw};
 use crate::physics::dim::Vec2;
 use crate::physics::energy::EnergyLedger;
 use crate::physics::walls::Control;
@@ -39,10 +39,10 @@ struct WallState {
     force_prev: Vec2,
 }
 
-/// A simulation's evolving state; `S` is a contact's state as saved
-/// ([`crate::physics::contact::model::Saved`]).
+/// A simulation's evolving state; `S` is a contact's state as saved and `E` its energy
+/// memory ([`crate::physics::contact::model::Saved`], [`crate::physics::contact::model::Memory`]).
 #[derive(Serialize, Deserialize)]
-struct Snapshot<S> {
+struct Snapshot<S, E> {
     /// What must match the simulation it is restored into.
     model: String,
     stages: Vec<String>,
@@ -59,11 +59,11 @@ struct Snapshot<S> {
     torque: Vec<f64>,
     walls: Vec<WallState>,
     /// `wall_hist[wall][grain]`, `wall_active[wall][grain]`.
-    wall_hist: Vec<Vec<(S, EnergyMemory)>>,
+    wall_hist: Vec<Vec<(S, E)>>,
     wall_active: Vec<Vec<bool>>,
     pairs: Vec<[u32; 2]>,
     hist: Vec<S>,
-    energy: Vec<EnergyMemory>,
+    energy: Vec<E>,
     active: Vec<bool>,
     at_build: Vec<Vec2>,
     builds: u64,
@@ -133,7 +133,7 @@ impl<L: ContactLaw> Simulation<L> {
     /// scene. An error says what does not fit (found before anything changes, but for
     /// the pair list's and the stages' own checks: the simulation is then not to be run).
     pub fn restore(&mut self, bytes: &[u8]) -> Result<(), String> {
-        let s: Snapshot<Saved<L>> = postcard::from_bytes(bytes).map_err(|e| format!("its state does not decode for this contact model ({e})"))?;
+        let s: Snapshot<Saved<L>, Memory<L>> = postcard::from_bytes(bytes).map_err(|e| format!("its state does not decode for this contact model ({e})"))?;
         let w = &self.world;
         let n = w.p.len();
         let stages: Vec<String> = self.stage_names().iter().map(|n| stage_kind(n).to_string()).collect();

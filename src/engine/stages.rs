@@ -59,6 +59,7 @@ impl<L: ContactLaw> Stage<L> for UpdateNeighbours {
             let pairs = w.neighbours.build(&w.p.x, &w.p.r, w.p.n_free, &w.boundary, &w.threads);
             if w.pairs.keep_energy {
                 w.ledger.add(&w.pairs.energy_sums());
+                w.ledger.rolling += w.pairs.rolling_taken();
             }
             w.pairs.replace(pairs, &w.p.r, &w.p.m, &w.threads);
         }

@@ -8,6 +8,7 @@ use crate::error::{Error, Shown};
 use crate::kernels::pairs::PairList;
 use crate::physics::boundary::Boundary;
 use crate::physics::contact::model::Held;
+use crate::physics::contact::rolling::Rolling;
 use crate::physics::contact::{ContactHistory, ContactLaw, ContactRecord};
 use crate::physics::dim::Vec2;
 use crate::physics::energy::{EnergyLedger, EnergyRow};
@@ -17,8 +18,10 @@ use crate::physics::walls::Wall;
 
 /// A contact law's state of one contact ([`Held`]: tangential and rolling).
 pub type State<L> = Held<<L as ContactLaw>::Tang, <L as ContactLaw>::Roll>;
+/// The rolling torque's part of a contact's energy memory under a contact law.
+pub type RollEnergy<L> = <<L as ContactLaw>::Roll as Rolling>::Energy;
 /// History type of a contact law.
-pub type Hist<L> = ContactHistory<State<L>>;
+pub type Hist<L> = ContactHistory<State<L>, RollEnergy<L>>;
 
 /// Everything that evolves.
 pub struct World<L: ContactLaw> {
@@ -26,7 +29,7 @@ pub struct World<L: ContactLaw> {
     pub boundary: Boundary,
     pub law: L,
     pub pair_table: PairTable,
-    pub pairs: PairList<State<L>>,
+    pub pairs: PairList<State<L>, RollEnergy<L>>,
     pub walls: Vec<Wall>,
     /// History of each free grain against each flat wall: `wall_hist[wall][grain]`.
     pub wall_hist: Vec<Vec<Hist<L>>>,
@@ -103,6 +106,7 @@ impl<L: ContactLaw> World<L> {
             return l;
         }
         l.add(&list.energy_sums());
+        l.rolling += list.rolling_taken();
         let p = &self.p;
         for (k, (&[i, j], e)) in list.pairs.iter().zip(&list.energy).enumerate() {
             if !list.active[k] {

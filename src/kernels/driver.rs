@@ -67,7 +67,7 @@ pub fn pair_contact<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Roll
     pair: [u32; 2],
     pc: &PairConst,
     h: &mut Held<T, Rr>,
-    e: &mut EnergyMemory,
+    e: &mut EnergyMemory<f64, Rr::Energy>,
     active: &mut bool,
 ) -> PairOut {
     let model = w.law;
@@ -163,10 +163,10 @@ fn four_pairs<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling, c
     }
     // With the ledger, the energy memories too, in lanes.
     if ENERGY {
-        let mut e = EnergyMemory::gather(std::array::from_fn(|l| &list.energy[ks[l]]), T::FRICTION, Rr::ON);
+        let mut e = ContactModel::<N, Dm, T, C, Rr>::gather_energy(std::array::from_fn(|l| &list.energy[ks[l]]), T::FRICTION);
         model.energy_step(input.n, input.dt, &c, &mut e);
         for (l, &k) in ks.iter().enumerate() {
-            e.store_lane(l, &mut list.energy[k], T::FRICTION);
+            ContactModel::<N, Dm, T, C, Rr>::store_energy_lane(&e, l, &mut list.energy[k], T::FRICTION);
         }
     }
     for l in 0..LANES {
@@ -232,7 +232,7 @@ pub struct PairSlices<'a, T: Tangential, Rr: Rolling> {
     pub pairs: CheckedPairs<'a>,
     pub consts: &'a [PairConst],
     pub hist: &'a mut [Held<T, Rr>],
-    pub energy: &'a mut [EnergyMemory],
+    pub energy: &'a mut [EnergyMemory<f64, Rr::Energy>],
     pub active: &'a mut [bool],
 }
 
@@ -273,7 +273,7 @@ pub fn compute_pairs<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rol
             w.law.energy_step(n, w.dt, &state, &mut energy[k]);
         }
     }
-    let mut none = EnergyMemory::default();
+    let mut none = EnergyMemory::<f64, Rr::Energy>::default();
     for &k in released {
         let k = k as usize;
         let e = if ENERGY { &mut energy[k] } else { &mut none };

@@ -5,11 +5,12 @@
 
 use crate::kernels::threads::Threads;
 use crate::physics::contact::EnergyMemory;
+use crate::physics::contact::rolling::RollingEnergy;
 use crate::physics::energy::EnergySums;
 
 /// The Verlet list and the history of each listed pair.
 #[derive(Clone, Debug, Default)]
-pub struct PairList<H> {
+pub struct PairList<H, X = ()> {
     /// Listed pairs, i < j, sorted (set by [`PairList::replace`] only).
     pub pairs: Pairs,
     /// What each pair's kernel would otherwise divide out at every step, parallel to `pairs`.
@@ -20,8 +21,9 @@ pub struct PairList<H> {
     pub reach: Vec<f64>,
     /// Tangential state of each pair, parallel to `pairs`.
     pub hist: Vec<H>,
-    /// Energy memory of each pair, parallel to `pairs` when `keep_energy`, else empty.
-    pub energy: Vec<EnergyMemory>,
+    /// Energy memory of each pair, parallel to `pairs` when `keep_energy`, else empty
+    /// (`X`: its rolling torque's part, `()` without rolling resistance).
+    pub energy: Vec<EnergyMemory<f64, X>>,
     /// True while the pair is (or was at the previous step) touching, parallel to `pairs`.
     pub active: Vec<bool>,
     /// Keep the energy memory (the run has the energy ledger on).
@@ -29,15 +31,15 @@ pub struct PairList<H> {
     /// The arrays of the list before the last rebuild, kept for the next one to fill:
     /// new arrays at every rebuild cost their page faults again (a quarter of the
     /// rebuild's time at 20 000 grains).
-    pub(crate) spare: Spare<H>,
+    pub(crate) spare: Spare<H, X>,
 }
 
 /// Spare per-pair arrays ([`PairList::replace`] swaps them with the list's).
 #[derive(Clone, Debug, Default)]
-pub(crate) struct Spare<H> {
+pub(crate) struct Spare<H, X = ()> {
     hist: Vec<H>,
     active: Vec<bool>,
-    energy: Vec<EnergyMemory>,
+    energy: Vec<EnergyMemory<f64, X>>,
 }
 
 /// The constants of a listed pair, computed once per neighbour-list build.
@@ -51,7 +53,7 @@ pub struct PairConst {
     pub inv_r_min: f64,
 }
 
-impl<H: Copy + Default + Send + Sync> PairList<H> {
+impl<H: Copy + Default + Send + Sync, X: RollingEnergy<f64>> PairList<H, X> {
     /// Replace the pairs, keeping the history of every pair that stays listed, and
     /// compute their constants from the radii `r` and masses `m`; on `threads`, each
     /// taking a stretch of the new list (the old list is sorted too, so a stretch finds
@@ -85,7 +87,7 @@ impl<H: Copy + Default + Send + Sync> PairList<H> {
     /// length, checked) and their states, parallel to them; the constants are computed
     /// again from the radii `r` and masses `m`, as the build computed them. An error
     /// says what does not fit.
-    pub fn restore(&mut self, pairs: Vec<[u32; 2]>, hist: Vec<H>, active: Vec<bool>, energy: Vec<EnergyMemory>, r: &[f64], m: &[f64]) -> Result<(), String> {
+    pub fn restore(&mut self, pairs: Vec<[u32; 2]>, hist: Vec<H>, active: Vec<bool>, energy: Vec<EnergyMemory<f64, X>>, r: &[f64], m: &[f64]) -> Result<(), String> {
         let np = pairs.len();
         if hist.len() != np || active.len() != np || energy.len() != if self.keep_energy { np } else { 0 } {
             return Err(format!("its pair list has {np} pairs but {} histories, {} flags and {} energy memories", hist.len(), active.len(), energy.len()));
@@ -111,6 +113,11 @@ impl<H: Copy + Default + Send + Sync> PairList<H> {
     pub fn energy_sums(&self) -> EnergySums {
         EnergySums::total(self.energy.iter().map(|e| &e.sums))
     }
+    /// The work the rolling torques of every listed pair took since last taken, added in
+    /// list order, J; zero without the energy ledger or rolling resistance.
+    pub fn rolling_taken(&self) -> f64 {
+        self.energy.iter().map(|e| e.rolling.taken()).sum()
+    }
     /// Number of pairs currently touching (active history).
     pub fn touching(&self) -> usize {
         self.active.iter().filter(|&&a| a).count()
@@ -128,19 +135,19 @@ fn constants(new: &[[u32; 2]], consts: &mut [PairConst], reach: &mut [f64], r: &
 }
 
 /// What the old list carries over to the new one: its pairs (sorted) and their states.
-struct Carried<'a, H> {
+struct Carried<'a, H, X> {
     pairs: &'a [[u32; 2]],
     hist: &'a [H],
     active: &'a [bool],
     /// Empty without the energy ledger.
-    energy: &'a [EnergyMemory],
+    energy: &'a [EnergyMemory<f64, X>],
 }
 
-impl<H: Copy + Default> Carried<'_, H> {
+impl<H: Copy + Default, X: RollingEnergy<f64>> Carried<'_, H, X> {
     /// The states of the pairs of the sorted stretch `new`: those listed before keep
     /// theirs, the others start afresh (every entry is written). The energy sums start
     /// at 0 in the new list: the ledger has taken the old list's.
-    fn carry(&self, new: &[[u32; 2]], hist: &mut [H], active: &mut [bool], mut energy: Option<&mut [EnergyMemory]>) {
+    fn carry(&self, new: &[[u32; 2]], hist: &mut [H], active: &mut [bool], mut energy: Option<&mut [EnergyMemory<f64, X>]>) {
         let old = self.pairs;
         let mut k = new.first().map_or(0, |first| old.partition_point(|p| p < first));
         for (m, p) in new.iter().enumerate() {
@@ -151,7 +158,7 @@ impl<H: Copy + Default> Carried<'_, H> {
             hist[m] = if kept { self.hist[k] } else { H::default() };
             active[m] = kept && self.active[k];
             if let Some(e) = energy.as_deref_mut() {
-                e[m] = if kept { EnergyMemory { sums: EnergySums::default(), ..self.energy[k] } } else { EnergyMemory::default() };
+                e[m] = if kept { self.energy[k].restarted() } else { EnergyMemory::default() };
             }
         }
     }

@@ -41,7 +41,8 @@ pub struct EnergyLedger {
     /// Energy dissipated by the general (viscous, per-grain) damping, J.
     pub general_damping: f64,
     /// Work taken from the grains by the rolling resistance's torques, J: dissipated, or
-    /// held for a while by a rolling spring (EPSD2, SDS) that is not sliding.
+    /// held for a while by a rolling spring (EPSD2, SDS) that is not sliding. Each contact
+    /// keeps its own in its energy memory's rolling part, taken as the other sums are.
     pub rolling: f64,
     /// Energy the tangential springs gained from stiffness and frame changes, less the
     /// elastic energy they hold now (the sum of `E_slip + W_spring`, see the module), J.
@@ -73,7 +74,6 @@ impl EnergyLedger {
         self.tangential_damping += s.tangential_damping;
         self.friction += s.friction;
         self.tangential_model += s.tangential_model;
-        self.rolling += s.rolling;
     }
     /// The tangential model's work `W_t`: what the ledger keeps plus the elastic energy
     /// the tangential springs hold now, J.
@@ -95,8 +95,6 @@ pub struct EnergySums<R = f64> {
     /// Tangential model work less the change of the stored tangential energy
     /// (`E_slip + W_spring`), J.
     pub tangential_model: R,
-    /// Taken by the rolling torque, J.
-    pub rolling: R,
 }
 
 impl std::ops::Add for EnergySums {
@@ -107,7 +105,6 @@ impl std::ops::Add for EnergySums {
             tangential_damping: self.tangential_damping + b.tangential_damping,
             friction: self.friction + b.friction,
             tangential_model: self.tangential_model + b.tangential_model,
-            rolling: self.rolling + b.rolling,
         }
     }
 }

@@ -10,7 +10,7 @@ use serde::{Deserialize, Serialize};
 use nalgebra::Vector2;
 
 use super::cohesion::{Cohesion, Dmt, NoCohesion};
-use super::rolling::{Cdt, Epsd2, NoRolling, Rolling, RollingInput, Sds};
+use super::rolling::{Cdt, Epsd2, NoRolling, Rolling, RollingEnergy, RollingInput, Sds};
 use super::damping::{Damping, LinearRestitution, TsujiFit, Undamped, Viscoelastic};
 use super::normal::{Hertz, Hooke, Normal};
 use super::tangential::{Frictionless, IncrementalForce, Tangential, TangentialForce, TangentialInput, TotalDisplacement};
@@ -172,48 +172,61 @@ pub struct ContactForce {
 /// keeps the two parts in separate arrays, and the energy part only with the energy
 /// ledger on: the force kernel reads and writes the tangential state alone.)
 #[derive(Clone, Copy, Debug, Default)]
-pub struct ContactHistory<H> {
+pub struct ContactHistory<H, X = ()> {
     /// The contact law's state ([`Held`]: the tangential formulation's and the rolling
     /// resistance's).
     pub state: H,
     /// What the energy accounting carries over.
-    pub energy: EnergyMemory,
+    pub energy: EnergyMemory<f64, X>,
 }
 
 /// What a contact's energy accounting carries from one step to the next: the previous
 /// values of the terms it integrates by the trapezoid rule, and the contact's sums of
-/// the ledger's terms since they were last taken ([`crate::physics::energy`]).
+/// the ledger's terms since they were last taken ([`crate::physics::energy`]); `X` the
+/// rolling torque's part ([`RollingEnergy`]: `()`, no room, without rolling resistance).
 /// (`R = Lanes`: of four contacts.)
 #[derive(Clone, Copy, Debug, Default, Serialize, Deserialize)]
-pub struct EnergyMemory<R: Real = f64> {
+pub struct EnergyMemory<R: Real = f64, X = ()> {
     /// Previous normal damping force (for the trapezoidal energy integrals), N.
     pub fd_prev: R,
-    /// Previous rolling torque, N m.
-    pub mr_prev: R,
     /// Previous elastic tangential force, N.
     pub fte_prev: Vector2<R>,
     /// Previous tangential damping force, N.
     pub ftd_prev: Vector2<R>,
     /// The ledger's terms this contact added since they were last taken, J.
     pub sums: EnergySums<R>,
+    /// The rolling torque's previous value and work.
+    pub rolling: X,
 }
 
-impl EnergyMemory<crate::physics::lanes::Lanes> {
-    /// Four contacts' memories in lanes; with `friction` false only what a frictionless
-    /// contact uses (the normal damping's previous force and sum), the rest 0; with
-    /// `rolling` false, the rolling torque's terms 0.
+impl<X: Copy> EnergyMemory<f64, X> {
+    /// The memory of a contact that goes on after its sums were taken: its previous
+    /// values, sums 0 (the rolling work included).
+    pub fn restarted(&self) -> Self
+    where
+        X: RollingEnergy<f64>,
+    {
+        let mut rolling = self.rolling;
+        rolling.take();
+        EnergyMemory { sums: EnergySums::default(), rolling, ..*self }
+    }
+}
+
+impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling> ContactModel<N, Dm, T, C, Rr> {
+    /// Four contacts' energy memories in lanes; with `friction` false only what a
+    /// frictionless contact uses (the normal damping's previous force and sum), the rest 0.
     #[inline(always)]
-    pub fn gather(h: [&EnergyMemory; crate::physics::lanes::LANES], friction: bool, rolling: bool) -> Self {
+    pub fn gather_energy(h: [&EnergyMemory<f64, Rr::Energy>; crate::physics::lanes::LANES], friction: bool) -> EnergyMemory<crate::physics::lanes::Lanes, Rr::EnergyLanes> {
         use crate::physics::lanes::{Lanes, gather, gather2};
         use simba::simd::SimdValue;
+        let rolling = Rr::gather_energy(h.map(|x| &x.rolling));
         if !friction {
             let z = Lanes::splat(0.0);
-            let sums = EnergySums { normal_damping: gather(|l| h[l].sums.normal_damping), tangential_damping: z, friction: z, tangential_model: z, rolling: z };
-            return EnergyMemory { fd_prev: gather(|l| h[l].fd_prev), mr_prev: z, fte_prev: Vector2::new(z, z), ftd_prev: Vector2::new(z, z), sums };
+            let sums = EnergySums { normal_damping: gather(|l| h[l].sums.normal_damping), tangential_damping: z, friction: z, tangential_model: z };
+            return EnergyMemory { fd_prev: gather(|l| h[l].fd_prev), fte_prev: Vector2::new(z, z), ftd_prev: Vector2::new(z, z), sums, rolling };
         }
         EnergyMemory {
             fd_prev: gather(|l| h[l].fd_prev),
-            mr_prev: if rolling { gather(|l| h[l].mr_prev) } else { Lanes::splat(0.0) },
             fte_prev: gather2(|l| h[l].fte_prev),
             ftd_prev: gather2(|l| h[l].ftd_prev),
             sums: EnergySums {
@@ -221,37 +234,41 @@ impl EnergyMemory<crate::physics::lanes::Lanes> {
                 tangential_damping: gather(|l| h[l].sums.tangential_damping),
                 friction: gather(|l| h[l].sums.friction),
                 tangential_model: gather(|l| h[l].sums.tangential_model),
-                rolling: if rolling { gather(|l| h[l].sums.rolling) } else { Lanes::splat(0.0) },
             },
+            rolling,
         }
     }
-    /// Write lane `l`'s memory to `m` (with `friction` false, only what a frictionless
-    /// contact uses).
+    /// Write lane `l` of the memories `e` to `m` (with `friction` false, only what a
+    /// frictionless contact uses).
     #[inline(always)]
-    pub fn store_lane(&self, l: usize, m: &mut EnergyMemory, friction: bool) {
+    pub fn store_energy_lane(e: &EnergyMemory<crate::physics::lanes::Lanes, Rr::EnergyLanes>, l: usize, m: &mut EnergyMemory<f64, Rr::Energy>, friction: bool) {
         use simba::simd::SimdValue;
         if friction {
-            *m = self.lane(l);
+            *m = Self::energy_lane(e, l);
         } else {
-            m.fd_prev = self.fd_prev.extract(l);
-            m.sums.normal_damping = self.sums.normal_damping.extract(l);
+            m.fd_prev = e.fd_prev.extract(l);
+            m.sums.normal_damping = e.sums.normal_damping.extract(l);
+            m.rolling = Rr::lane_energy(&e.rolling, l);
         }
     }
     /// The memory in lane `l`.
     #[inline(always)]
-    pub fn lane(&self, l: usize) -> EnergyMemory {
+    pub fn energy_lane(e: &EnergyMemory<crate::physics::lanes::Lanes, Rr::EnergyLanes>, l: usize) -> EnergyMemory<f64, Rr::Energy> {
         use crate::physics::lanes::lane2;
         use simba::simd::SimdValue;
-        let s = &self.sums;
+        let s = &e.sums;
         EnergyMemory {
-            fd_prev: self.fd_prev.extract(l),
-            mr_prev: self.mr_prev.extract(l),
-            fte_prev: lane2(&self.fte_prev, l),
-            ftd_prev: lane2(&self.ftd_prev, l),
-            sums: EnergySums { normal_damping: s.normal_damping.extract(l), tangential_damping: s.tangential_damping.extract(l), friction: s.friction.extract(l), tangential_model: s.tangential_model.extract(l), rolling: s.rolling.extract(l) },
+            fd_prev: e.fd_prev.extract(l),
+            fte_prev: lane2(&e.fte_prev, l),
+            ftd_prev: lane2(&e.ftd_prev, l),
+            sums: EnergySums { normal_damping: s.normal_damping.extract(l), tangential_damping: s.tangential_damping.extract(l), friction: s.friction.extract(l), tangential_model: s.tangential_model.extract(l) },
+            rolling: Rr::lane_energy(&e.rolling, l),
         }
     }
 }
+
+/// A contact's energy memory under law `L`.
+pub type Memory<L> = EnergyMemory<f64, <<L as ContactLaw>::Roll as Rolling>::Energy>;
 
 /// A contact's state of law `L` as a checkpoint stores it.
 pub type Saved<L> = (<<L as ContactLaw>::Tang as Tangential>::Saved, <<L as ContactLaw>::Roll as Rolling>::Saved);
@@ -389,13 +406,14 @@ impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling> ContactMod
         &self,
         c: &ContactInput,
         pm: &PairMaterial,
-        h: &mut ContactHistory<Held<T, Rr>>,
+        h: &mut ContactHistory<Held<T, Rr>, Rr::Energy>,
         ledger: &mut EnergyLedger,
     ) -> ContactForce {
         let s = self.force(c, pm, &mut h.state);
         if ENERGY {
             self.energy_step(c.n, c.dt, &s, &mut h.energy);
             ledger.add(&std::mem::take(&mut h.energy.sums));
+            ledger.rolling += h.energy.rolling.take();
             let pulloff = if C::ON { pm.pulloff * c.r_star } else { 0.0 };
             let (un, ut) = Self::elastic(s.kn, s.kt, pulloff, c.dn, s.tangential.elastic);
             ledger.elastic_normal += un;
@@ -410,7 +428,7 @@ impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling> ContactMod
     /// trapezoidal work integrals of the step added to its sums, the previous-step
     /// values moved on. No branch on the data: the same bits per lane as alone.
     #[inline(always)]
-    pub fn energy_step<R: Real>(&self, n: Vector2<R>, dt: R, s: &ContactState<R>, h: &mut EnergyMemory<R>) {
+    pub fn energy_step<R: Real, X: RollingEnergy<R>>(&self, n: Vector2<R>, dt: R, s: &ContactState<R>, h: &mut EnergyMemory<R, X>) {
         let dc = s.vc * dt;
         let fd = s.normal - s.elastic_normal;
         h.sums.normal_damping -= k::<R>(0.5) * (h.fd_prev + fd) * dc.dot(&n);
@@ -424,9 +442,7 @@ impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling> ContactMod
             h.ftd_prev = tf.damping;
         }
         if Rr::ON {
-            // The rolling torques' work on the two grains, M (w_i - w_j) dt.
-            h.sums.rolling -= k::<R>(0.5) * (h.mr_prev + s.rolling) * s.roll * dt;
-            h.mr_prev = s.rolling;
+            h.rolling.step(s.rolling, s.roll, dt);
         }
     }
 
@@ -447,7 +463,7 @@ impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling> ContactMod
     /// `h` (`roll`: the relative spin w_i - w_j, rad/s, for the rolling torque's work). The sums stay, for the ledger to take.
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
-    pub fn release<const ENERGY: bool>(&self, c_velocity: Vec2, n: Vec2, roll: f64, dt: f64, t: &mut Held<T, Rr>, h: &mut EnergyMemory) {
+    pub fn release<const ENERGY: bool>(&self, c_velocity: Vec2, n: Vec2, roll: f64, dt: f64, t: &mut Held<T, Rr>, h: &mut EnergyMemory<f64, Rr::Energy>) {
         if ENERGY {
             let dc = c_velocity * dt;
             h.sums.normal_damping -= 0.5 * h.fd_prev * dc.dot(&n);
@@ -456,12 +472,12 @@ impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling> ContactMod
                 h.sums.tangential_model += 0.5 * h.fte_prev.dot(&dc);
             }
             if Rr::ON {
-                h.sums.rolling -= 0.5 * h.mr_prev * roll * dt;
+                h.rolling.release(roll, dt);
             }
         }
         *t = Default::default();
         if ENERGY {
-            *h = EnergyMemory { sums: h.sums, ..Default::default() };
+            *h = EnergyMemory { sums: h.sums, rolling: h.rolling, ..Default::default() };
         }
     }
 }

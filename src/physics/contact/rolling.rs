@@ -62,11 +62,80 @@ pub trait Rolling: Copy + Send + Sync + std::fmt::Debug + 'static {
     fn gather(h: [&Self::History<f64>; LANES]) -> Self::History<Lanes>;
     /// Lane `l` of a state in lanes.
     fn lane(h: &Self::History<Lanes>, l: usize) -> Self::History<f64>;
+    /// What a contact's energy accounting keeps for the rolling torque (`()` without).
+    type Energy: RollingEnergy<f64> + PartialEq + serde::Serialize + serde::de::DeserializeOwned;
+    /// Four contacts' of it in lanes.
+    type EnergyLanes: RollingEnergy<Lanes>;
+    fn gather_energy(e: [&Self::Energy; LANES]) -> Self::EnergyLanes;
+    fn lane_energy(e: &Self::EnergyLanes, l: usize) -> Self::Energy;
     /// The torque on grain i, N m (j gets the opposite), advancing the state `h`.
     fn torque<R: Real>(&self, h: &mut Self::History<R>, inp: &RollingInput<R>) -> R;
     /// The law and its parameters, for `explain` and checkpoints.
     fn label(&self) -> String {
         Self::NAME.to_string()
+    }
+}
+
+/// The rolling torque's part of a contact's energy memory
+/// ([`crate::physics::contact::EnergyMemory`]): its previous value and the work it took
+/// from the grains since the ledger last took it. A contact without rolling resistance
+/// keeps `()`: no room, no work.
+pub trait RollingEnergy<R: Real>: Copy + Default + Send + Sync + std::fmt::Debug {
+    /// One step of torque `m` on grain i (N m) against the relative spin `w` (rad/s) over
+    /// `dt` (s): the trapezoid rule's work, as every term of the ledger.
+    fn step(&mut self, m: R, w: R, dt: R);
+    /// The contact ended over this step (the torque fell to 0): close the integral and
+    /// forget the previous torque; the work stays to be taken.
+    fn release(&mut self, w: R, dt: R);
+    /// The work taken from the grains since last taken, J; left at 0.
+    fn take(&mut self) -> R;
+    /// The work taken, J (unchanged).
+    fn taken(&self) -> R;
+}
+
+impl<R: Real> RollingEnergy<R> for () {
+    #[inline(always)]
+    fn step(&mut self, _: R, _: R, _: R) {}
+    #[inline(always)]
+    fn release(&mut self, _: R, _: R) {}
+    #[inline(always)]
+    fn take(&mut self) -> R {
+        R::zero()
+    }
+    #[inline(always)]
+    fn taken(&self) -> R {
+        R::zero()
+    }
+}
+
+/// The rolling torque's energy memory of one contact (or one per lane).
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct RollingMemory<R = f64> {
+    /// The previous step's torque on grain i, N m.
+    pub m_prev: R,
+    /// Work the torques took from the grains since the ledger last took it, J.
+    pub taken: R,
+}
+
+impl<R: Real> RollingEnergy<R> for RollingMemory<R> {
+    #[inline(always)]
+    fn step(&mut self, m: R, w: R, dt: R) {
+        // The torques' power on the two grains is M (w_i - w_j).
+        self.taken -= k::<R>(0.5) * (self.m_prev + m) * w * dt;
+        self.m_prev = m;
+    }
+    #[inline(always)]
+    fn release(&mut self, w: R, dt: R) {
+        self.taken -= k::<R>(0.5) * self.m_prev * w * dt;
+        self.m_prev = R::zero();
+    }
+    #[inline(always)]
+    fn take(&mut self) -> R {
+        std::mem::replace(&mut self.taken, R::zero())
+    }
+    #[inline(always)]
+    fn taken(&self) -> R {
+        self.taken
     }
 }
 
@@ -77,6 +146,12 @@ pub struct NoRolling;
 impl Rolling for NoRolling {
     const NAME: &'static str = "";
     const ON: bool = false;
+    type Energy = ();
+    type EnergyLanes = ();
+    #[inline(always)]
+    fn gather_energy(_: [&(); LANES]) {}
+    #[inline(always)]
+    fn lane_energy(_: &(), _: usize) {}
     type History<R: Real> = ();
     type Saved = ();
     fn save(_: ()) {}
@@ -98,6 +173,16 @@ pub struct Cdt;
 impl Rolling for Cdt {
     const NAME: &'static str = "CDT rolling";
     const ON: bool = true;
+    type Energy = RollingMemory;
+    type EnergyLanes = RollingMemory<Lanes>;
+    #[inline(always)]
+    fn gather_energy(e: [&RollingMemory; LANES]) -> RollingMemory<Lanes> {
+        RollingMemory { m_prev: gather(|l| e[l].m_prev), taken: gather(|l| e[l].taken) }
+    }
+    #[inline(always)]
+    fn lane_energy(e: &RollingMemory<Lanes>, l: usize) -> RollingMemory {
+        RollingMemory { m_prev: e.m_prev.extract(l), taken: e.taken.extract(l) }
+    }
     type History<R: Real> = ();
     type Saved = ();
     fn save(_: ()) {}
@@ -130,6 +215,16 @@ pub struct Epsd2;
 impl Rolling for Epsd2 {
     const NAME: &'static str = "EPSD2 rolling";
     const ON: bool = true;
+    type Energy = RollingMemory;
+    type EnergyLanes = RollingMemory<Lanes>;
+    #[inline(always)]
+    fn gather_energy(e: [&RollingMemory; LANES]) -> RollingMemory<Lanes> {
+        RollingMemory { m_prev: gather(|l| e[l].m_prev), taken: gather(|l| e[l].taken) }
+    }
+    #[inline(always)]
+    fn lane_energy(e: &RollingMemory<Lanes>, l: usize) -> RollingMemory {
+        RollingMemory { m_prev: e.m_prev.extract(l), taken: e.taken.extract(l) }
+    }
     type History<R: Real> = R;
     type Saved = f64;
     fn save(h: f64) -> f64 {
@@ -170,6 +265,16 @@ pub struct Sds {
 impl Rolling for Sds {
     const NAME: &'static str = "SDS rolling";
     const ON: bool = true;
+    type Energy = RollingMemory;
+    type EnergyLanes = RollingMemory<Lanes>;
+    #[inline(always)]
+    fn gather_energy(e: [&RollingMemory; LANES]) -> RollingMemory<Lanes> {
+        RollingMemory { m_prev: gather(|l| e[l].m_prev), taken: gather(|l| e[l].taken) }
+    }
+    #[inline(always)]
+    fn lane_energy(e: &RollingMemory<Lanes>, l: usize) -> RollingMemory {
+        RollingMemory { m_prev: e.m_prev.extract(l), taken: e.taken.extract(l) }
+    }
     type History<R: Real> = R;
     type Saved = f64;
     fn save(h: f64) -> f64 {
