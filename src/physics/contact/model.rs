@@ -10,7 +10,7 @@ use serde::{Deserialize, Serialize};
 use nalgebra::Vector2;
 
 use super::cohesion::{Cohesion, Dmt, NoCohesion};
-use super::rolling::{Cdt, Epsd2, NoRolling, Rolling, RollingEnergy, RollingInput, Sds};
+use super::rolling::{Cdt, Epsd2, InLanes, NoRolling, Rolling, RollingEnergy, RollingInput, Sds};
 use super::damping::{Damping, LinearRestitution, TsujiFit, Undamped, Viscoelastic};
 use super::normal::{Hertz, Hooke, Normal};
 use super::tangential::{Frictionless, IncrementalForce, Tangential, TangentialForce, TangentialInput, TotalDisplacement};
@@ -216,10 +216,10 @@ impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling> ContactMod
     /// Four contacts' energy memories in lanes; with `friction` false only what a
     /// frictionless contact uses (the normal damping's previous force and sum), the rest 0.
     #[inline(always)]
-    pub fn gather_energy(h: [&EnergyMemory<f64, Rr::Energy>; crate::physics::lanes::LANES], friction: bool) -> EnergyMemory<crate::physics::lanes::Lanes, Rr::EnergyLanes> {
+    pub fn gather_energy(h: [&EnergyMemory<f64, Rr::Energy>; crate::physics::lanes::LANES], friction: bool) -> EnergyMemory<crate::physics::lanes::Lanes, <Rr::Energy as InLanes>::Lanes> {
         use crate::physics::lanes::{Lanes, gather, gather2};
         use simba::simd::SimdValue;
-        let rolling = Rr::gather_energy(h.map(|x| &x.rolling));
+        let rolling = InLanes::gather(h.map(|x| &x.rolling));
         if !friction {
             let z = Lanes::splat(0.0);
             let sums = EnergySums { normal_damping: gather(|l| h[l].sums.normal_damping), tangential_damping: z, friction: z, tangential_model: z };
@@ -241,19 +241,19 @@ impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling> ContactMod
     /// Write lane `l` of the memories `e` to `m` (with `friction` false, only what a
     /// frictionless contact uses).
     #[inline(always)]
-    pub fn store_energy_lane(e: &EnergyMemory<crate::physics::lanes::Lanes, Rr::EnergyLanes>, l: usize, m: &mut EnergyMemory<f64, Rr::Energy>, friction: bool) {
+    pub fn store_energy_lane(e: &EnergyMemory<crate::physics::lanes::Lanes, <Rr::Energy as InLanes>::Lanes>, l: usize, m: &mut EnergyMemory<f64, Rr::Energy>, friction: bool) {
         use simba::simd::SimdValue;
         if friction {
             *m = Self::energy_lane(e, l);
         } else {
             m.fd_prev = e.fd_prev.extract(l);
             m.sums.normal_damping = e.sums.normal_damping.extract(l);
-            m.rolling = Rr::lane_energy(&e.rolling, l);
+            m.rolling = InLanes::lane(&e.rolling, l);
         }
     }
     /// The memory in lane `l`.
     #[inline(always)]
-    pub fn energy_lane(e: &EnergyMemory<crate::physics::lanes::Lanes, Rr::EnergyLanes>, l: usize) -> EnergyMemory<f64, Rr::Energy> {
+    pub fn energy_lane(e: &EnergyMemory<crate::physics::lanes::Lanes, <Rr::Energy as InLanes>::Lanes>, l: usize) -> EnergyMemory<f64, Rr::Energy> {
         use crate::physics::lanes::lane2;
         use simba::simd::SimdValue;
         let s = &e.sums;
@@ -262,7 +262,7 @@ impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling> ContactMod
             fte_prev: lane2(&e.fte_prev, l),
             ftd_prev: lane2(&e.ftd_prev, l),
             sums: EnergySums { normal_damping: s.normal_damping.extract(l), tangential_damping: s.tangential_damping.extract(l), friction: s.friction.extract(l), tangential_model: s.tangential_model.extract(l) },
-            rolling: Rr::lane_energy(&e.rolling, l),
+            rolling: InLanes::lane(&e.rolling, l),
         }
     }
 }

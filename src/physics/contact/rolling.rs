@@ -62,12 +62,9 @@ pub trait Rolling: Copy + Send + Sync + std::fmt::Debug + 'static {
     fn gather(h: [&Self::History<f64>; LANES]) -> Self::History<Lanes>;
     /// Lane `l` of a state in lanes.
     fn lane(h: &Self::History<Lanes>, l: usize) -> Self::History<f64>;
-    /// What a contact's energy accounting keeps for the rolling torque (`()` without).
-    type Energy: RollingEnergy<f64> + PartialEq + serde::Serialize + serde::de::DeserializeOwned;
-    /// Four contacts' of it in lanes.
-    type EnergyLanes: RollingEnergy<Lanes>;
-    fn gather_energy(e: [&Self::Energy; LANES]) -> Self::EnergyLanes;
-    fn lane_energy(e: &Self::EnergyLanes, l: usize) -> Self::Energy;
+    /// What a contact's energy accounting keeps for the rolling torque (`()` without),
+    /// and four contacts' of it in lanes.
+    type Energy: RollingEnergy<f64> + InLanes<Lanes: RollingEnergy<Lanes>> + PartialEq + serde::Serialize + serde::de::DeserializeOwned;
     /// The torque on grain i, N m (j gets the opposite), advancing the state `h`.
     fn torque<R: Real>(&self, h: &mut Self::History<R>, inp: &RollingInput<R>) -> R;
     /// The law and its parameters, for `explain` and checkpoints.
@@ -91,6 +88,35 @@ pub trait RollingEnergy<R: Real>: Copy + Default + Send + Sync + std::fmt::Debug
     fn take(&mut self) -> R;
     /// The work taken, J (unchanged).
     fn taken(&self) -> R;
+}
+
+/// A value of one contact that four contacts keep in SIMD lanes.
+pub trait InLanes: Sized {
+    type Lanes;
+    /// Four contacts' values in lanes.
+    fn gather(x: [&Self; LANES]) -> Self::Lanes;
+    /// Lane `l` of them.
+    fn lane(x: &Self::Lanes, l: usize) -> Self;
+}
+
+impl InLanes for () {
+    type Lanes = ();
+    #[inline(always)]
+    fn gather(_: [&(); LANES]) {}
+    #[inline(always)]
+    fn lane(_: &(), _: usize) {}
+}
+
+impl InLanes for RollingMemory {
+    type Lanes = RollingMemory<Lanes>;
+    #[inline(always)]
+    fn gather(e: [&RollingMemory; LANES]) -> RollingMemory<Lanes> {
+        RollingMemory { m_prev: gather(|l| e[l].m_prev), taken: gather(|l| e[l].taken) }
+    }
+    #[inline(always)]
+    fn lane(e: &RollingMemory<Lanes>, l: usize) -> RollingMemory {
+        RollingMemory { m_prev: e.m_prev.extract(l), taken: e.taken.extract(l) }
+    }
 }
 
 impl<R: Real> RollingEnergy<R> for () {
@@ -147,11 +173,6 @@ impl Rolling for NoRolling {
     const NAME: &'static str = "";
     const ON: bool = false;
     type Energy = ();
-    type EnergyLanes = ();
-    #[inline(always)]
-    fn gather_energy(_: [&(); LANES]) {}
-    #[inline(always)]
-    fn lane_energy(_: &(), _: usize) {}
     type History<R: Real> = ();
     type Saved = ();
     fn save(_: ()) {}
@@ -174,15 +195,6 @@ impl Rolling for Cdt {
     const NAME: &'static str = "CDT rolling";
     const ON: bool = true;
     type Energy = RollingMemory;
-    type EnergyLanes = RollingMemory<Lanes>;
-    #[inline(always)]
-    fn gather_energy(e: [&RollingMemory; LANES]) -> RollingMemory<Lanes> {
-        RollingMemory { m_prev: gather(|l| e[l].m_prev), taken: gather(|l| e[l].taken) }
-    }
-    #[inline(always)]
-    fn lane_energy(e: &RollingMemory<Lanes>, l: usize) -> RollingMemory {
-        RollingMemory { m_prev: e.m_prev.extract(l), taken: e.taken.extract(l) }
-    }
     type History<R: Real> = ();
     type Saved = ();
     fn save(_: ()) {}
@@ -216,15 +228,6 @@ impl Rolling for Epsd2 {
     const NAME: &'static str = "EPSD2 rolling";
     const ON: bool = true;
     type Energy = RollingMemory;
-    type EnergyLanes = RollingMemory<Lanes>;
-    #[inline(always)]
-    fn gather_energy(e: [&RollingMemory; LANES]) -> RollingMemory<Lanes> {
-        RollingMemory { m_prev: gather(|l| e[l].m_prev), taken: gather(|l| e[l].taken) }
-    }
-    #[inline(always)]
-    fn lane_energy(e: &RollingMemory<Lanes>, l: usize) -> RollingMemory {
-        RollingMemory { m_prev: e.m_prev.extract(l), taken: e.taken.extract(l) }
-    }
     type History<R: Real> = R;
     type Saved = f64;
     fn save(h: f64) -> f64 {
@@ -266,15 +269,6 @@ impl Rolling for Sds {
     const NAME: &'static str = "SDS rolling";
     const ON: bool = true;
     type Energy = RollingMemory;
-    type EnergyLanes = RollingMemory<Lanes>;
-    #[inline(always)]
-    fn gather_energy(e: [&RollingMemory; LANES]) -> RollingMemory<Lanes> {
-        RollingMemory { m_prev: gather(|l| e[l].m_prev), taken: gather(|l| e[l].taken) }
-    }
-    #[inline(always)]
-    fn lane_energy(e: &RollingMemory<Lanes>, l: usize) -> RollingMemory {
-        RollingMemory { m_prev: e.m_prev.extract(l), taken: e.taken.extract(l) }
-    }
     type History<R: Real> = R;
     type Saved = f64;
     fn save(h: f64) -> f64 {
