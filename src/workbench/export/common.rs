@@ -124,3 +124,119 @@ pub fn escaped(s: &str, also: &[char]) -> String {
 pub(crate) fn f(v: f64) -> String {
     format!("{v:.17e}")
 }
+
+/// What a deck needs of the contacts each pair of materials can make: the distinct values
+/// (to 1e-12) of `key(a, b, m*, R*)` over the contacts between grains of materials a and
+/// b, indexed `[a * n + b]` (both orders), and of `key(wall material, a, m, r)` over each
+/// flat wall's contacts with the free grains of material a, `[wall][a]` (R* = r, m* = m).
+/// Contacts: free grains with free grains (a material's grain with another of its own
+/// only if it has two), free grains with glued ones. The decks need only the first value
+/// and whether there is a second, so each list stops at two distinct values. Each
+/// material's grains are read as their first three distinct (m, r) free and two glued: a
+/// material's grains are of one density, so distinct grains differ in mass, and the keys
+/// the decks use (the reduced mass; the derived spring's kn, which grows with R* and m*)
+/// grow with a partner's mass, so three of them already give two values with any grain
+/// (two with a grain of their own). The work is linear in the grains (a million-grain
+/// packing of all-different radii is read in one pass).
+pub(crate) struct ContactKinds {
+    pub pairs: Vec<Vec<f64>>,
+    pub walls: Vec<Vec<Vec<f64>>>,
+}
+
+pub(crate) fn contact_kinds(n: usize, p: &crate::physics::particles::Particles, walls: &[crate::physics::walls::Wall], key: impl Fn(usize, usize, f64, f64) -> f64) -> ContactKinds {
+    let same = |x: f64, m: f64| (x - m).abs() <= 1e-12 * m.abs();
+    let add = |list: &mut Vec<f64>, k: f64| {
+        if list.len() < 2 && !list.iter().any(|&v| same(k, v)) {
+            list.push(k);
+        }
+    };
+    // Each material's distinct (m, r) of free grains, with how many, and of glued grains.
+    let mut free: Vec<Vec<((f64, f64), usize)>> = vec![Vec::new(); n];
+    let mut glued: Vec<Vec<((f64, f64), usize)>> = vec![Vec::new(); n];
+    for k in 0..p.len() {
+        let (m, r, mat) = (p.m[k], p.r[k], p.material[k] as usize);
+        let (list, cap) = if k < p.n_free { (&mut free[mat], 3) } else { (&mut glued[mat], 2) };
+        match list.iter().position(|((x, y), _)| same(*x, m) && same(*y, r)) {
+            Some(j) => list[j].1 += 1,
+            None if list.len() < cap => list.push(((m, r), 1)),
+            None => {}
+        }
+    }
+    let reduced = crate::physics::material::reduced;
+    let mut pairs = vec![Vec::new(); n * n];
+    // A contact of materials a and b at (m*, R*), listed for both orders.
+    let meet = |pairs: &mut Vec<Vec<f64>>, a: usize, b: usize, m: f64, r: f64| {
+        let k = key(a, b, m, r);
+        add(&mut pairs[a * n + b], k);
+        add(&mut pairs[b * n + a], k);
+    };
+    for a in 0..n {
+        for (ka, &((ma, ra), ca)) in free[a].iter().enumerate() {
+            for (b, fb) in free.iter().enumerate().skip(a) {
+                for (kb, &((mb, rb), _)) in fb.iter().enumerate() {
+                    if b > a || kb > ka || (kb == ka && ca > 1) {
+                        meet(&mut pairs, a, b, reduced(ma, mb), reduced(ra, rb));
+                    }
+                }
+            }
+            for (b, g) in glued.iter().enumerate() {
+                for &((mb, rb), _) in g {
+                    meet(&mut pairs, a, b, reduced(ma, mb), reduced(ra, rb));
+                }
+            }
+        }
+    }
+    let walls = walls
+        .iter()
+        .map(|w| {
+            let mut per = vec![Vec::new(); n];
+            if w.is_flat() {
+                for (a, fa) in free.iter().enumerate() {
+                    for &((m, r), _) in fa {
+                        add(&mut per[a], key(w.material, a, m, r));
+                    }
+                }
+            }
+            per
+        })
+        .collect();
+    ContactKinds { pairs, walls }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Grains of radii `r` (m) and density 2500 kg/m^3, the first `n_free` free.
+    fn grains(r: &[f64], n_free: usize) -> crate::physics::particles::Particles {
+        let mut p = crate::physics::particles::Particles::default();
+        for &r in r {
+            let m = 4.0 / 3.0 * std::f64::consts::PI * r * r * r * 2500.0;
+            p.push(crate::physics::dim::Vec2::zeros(), crate::physics::dim::Vec2::zeros(), 0.0, r, m, 0.4 * m * r * r, 0);
+        }
+        p.n_free = n_free;
+        p
+    }
+
+    #[test]
+    fn contact_kinds_tell_one_from_several_in_one_pass() {
+        // 100 000 free grains of all-different radii and two glued ones: every list holds
+        // the first two kinds found, read in one pass (listing every kind, as the first
+        // version did, never finished on the 5000-grain cell).
+        let n = 100_000;
+        let r: Vec<f64> = (0..n + 2).map(|k| 1e-3 * (1.0 + k as f64 / n as f64)).collect();
+        let m_star = |_: usize, _: usize, m: f64, _: f64| m;
+        let kinds = contact_kinds(1, &grains(&r, n), &[], m_star);
+        assert_eq!(kinds.pairs[0].len(), 2);
+        // Two equal grains: one kind; a grain of each of two sizes: one kind (they meet
+        // only each other); three sizes: two.
+        assert_eq!(contact_kinds(1, &grains(&[1e-3, 1e-3], 2), &[], m_star).pairs[0].len(), 1);
+        assert_eq!(contact_kinds(1, &grains(&[1e-3, 2e-3], 2), &[], m_star).pairs[0].len(), 1);
+        assert_eq!(contact_kinds(1, &grains(&[1e-3, 2e-3, 3e-3], 3), &[], m_star).pairs[0].len(), 2);
+        // A free grain and a glued one of another size: one kind.
+        assert_eq!(contact_kinds(1, &grains(&[1e-3, 2e-3], 1), &[], m_star).pairs[0].len(), 1);
+        // Kinds that differ but share the key count once: every pair of the 100 000 grains
+        // under a key that ignores them.
+        assert_eq!(contact_kinds(1, &grains(&r, n), &[], |_, _, _, _| 0.0).pairs[0].len(), 1);
+    }
+}
