@@ -160,13 +160,13 @@ fn lanes_match_alone<N: grainlab::physics::contact::normal::Normal, D: grainlab:
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(300))]
     #[test]
-    fn four_lanes_give_each_contact_its_own_bits(c0 in contact(), c1 in contact(), c2 in contact(), c3 in contact(), clamp in any::<bool>(), lever in 0usize..3) {
+    fn four_lanes_give_each_contact_its_own_bits(c0 in contact(), c1 in contact(), c2 in contact(), c3 in contact(), clamp in any::<bool>(), lever in 0usize..4) {
         use grainlab::physics::contact::LeverArm;
         use grainlab::physics::contact::tangential::{IncrementalForce, IncrementalState, TotalDisplacement};
         use grainlab::physics::contact::damping::{LinearRestitution, TsujiFit, Viscoelastic};
         use grainlab::physics::contact::normal::{Hertz, Hooke};
         use grainlab::physics::contact::rolling::{Cdt, Epsd2, RollingMemory, Sds};
-        let lever = [LeverArm::Radius, LeverArm::RadiusMinusHalfOverlap, LeverArm::Yade][lever];
+        let lever = [LeverArm::Radius, LeverArm::RadiusMinusHalfOverlap, LeverArm::Yade, LeverArm::ContactPoint][lever];
         let cs = [c0, c1, c2, c3];
         let v = |v: &Vec2| vec![v.x.to_bits(), v.y.to_bits()];
         let incremental = |c: &[f64; 9]| IncrementalState { force: Vec2::new(c[5], c[6]) * 1e3, n_prev: Vec2::new(c[7].cos(), c[7].sin()) };

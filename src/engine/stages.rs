@@ -223,7 +223,7 @@ impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling, const ENER
 #[inline(always)]
 fn wall_input<T: Tangential, Rr: Rolling>(lever: crate::physics::contact::LeverArm, p: &crate::physics::particles::Particles, i: usize, wall: &crate::physics::walls::Wall, n: Vec2, dn: f64, dt: f64) -> ContactInput {
     let ri = p.r[i];
-    let spin = if T::FRICTION { lever.arm(ri, dn) * p.omega[i] } else { 0.0 };
+    let spin = if T::FRICTION { lever.wall_arm(ri, dn) * p.omega[i] } else { 0.0 };
     let (roll, roll_scale) = if Rr::ON { (p.omega[i], lever.wall_rolling(ri, dn)) } else { (0.0, 1.0) };
     ContactInput { n, dn, r_star: ri, sqrt_m_star: p.m[i].sqrt(), v_rel: p.v[i] - wall.v, spin, dt, tangential_scale: 1.0, roll, roll_scale }
 }

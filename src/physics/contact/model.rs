@@ -36,6 +36,11 @@ pub enum LeverArm {
     /// centre projected onto the wall). Not energy-consistent by design: the work of the
     /// tangential force and its torque differ by O(dn/r).
     Yade,
+    /// The distance from the centre to the contact point, in the contact velocity and the
+    /// torque: r - dn/2 for pairs (the middle of the overlap) and r - dn on a flat wall
+    /// (the centre projected onto the wall): YADE 2023's `Law2_ScGeom_ViscElPhys_Basic`,
+    /// the linear spring's law there (no ratcheting correction).
+    ContactPoint,
 }
 
 impl LeverArm {
@@ -44,7 +49,15 @@ impl LeverArm {
     pub fn arm<R: Real>(self, r: R, dn: R) -> R {
         match self {
             LeverArm::Radius | LeverArm::Yade => r,
-            LeverArm::RadiusMinusHalfOverlap => r - k::<R>(0.5) * dn,
+            LeverArm::RadiusMinusHalfOverlap | LeverArm::ContactPoint => r - k::<R>(0.5) * dn,
+        }
+    }
+    /// The arm of the spin in the contact-point velocity of a grain on a flat wall, m.
+    #[inline(always)]
+    pub fn wall_arm(self, r: f64, dn: f64) -> f64 {
+        match self {
+            LeverArm::ContactPoint => r - dn,
+            _ => self.arm(r, dn),
         }
     }
     /// The torque arm of a grain-grain contact, m.
@@ -52,14 +65,14 @@ impl LeverArm {
     pub fn torque_arm<R: Real>(self, r: R, dn: R) -> R {
         match self {
             LeverArm::Radius => r,
-            LeverArm::RadiusMinusHalfOverlap | LeverArm::Yade => r - k::<R>(0.5) * dn,
+            LeverArm::RadiusMinusHalfOverlap | LeverArm::Yade | LeverArm::ContactPoint => r - k::<R>(0.5) * dn,
         }
     }
     /// The torque arm of a grain on a flat wall, m.
     #[inline(always)]
     pub fn wall_torque_arm(self, r: f64, dn: f64) -> f64 {
         match self {
-            LeverArm::Yade => r - dn,
+            LeverArm::Yade | LeverArm::ContactPoint => r - dn,
             _ => self.torque_arm(r, dn),
         }
     }
@@ -310,6 +323,7 @@ pub trait ContactLaw: Copy + Send + Sync + 'static {
             match (Self::Tang::FRICTION, o.lever_arm) {
                 (true, LeverArm::RadiusMinusHalfOverlap) => ", arm r-dn/2",
                 (true, LeverArm::Yade) => ", YADE ratcheting-free kinematics",
+                (true, LeverArm::ContactPoint) => ", arm to the contact point",
                 _ => "",
             }
         )
