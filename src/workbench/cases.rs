@@ -312,10 +312,12 @@ fn tsuji_cases(out: &mut Vec<Case>) {
 }
 
 /// The linear spring against LIGGGHTS (`model hooke` and `hooke/stiffness`, tangential
-/// history, its lever arm): a head-on restitution grid for both forms (e = 0.1, 0.5, 0.9;
-/// t_c/50 and t_c/500; with and without the clamp), oblique impacts on a flat wall
-/// (derived stiffness: the wall contact has R* = r, m* = m) and on a resting grain (given
-/// stiffness), and the shear cell (derived stiffness).
+/// history, its lever arm), LAMMPS (head-on) and YADE (`ViscElMat`, the incremental
+/// force, its kinematics and clamp): a head-on restitution grid for both forms (e = 0.1,
+/// 0.5, 0.9; t_c/50 and t_c/500; with and without the clamp, YADE with it), oblique
+/// impacts on a flat wall (derived stiffness: the wall contact has R* = r, m* = m) and on
+/// a resting grain (given stiffness) in each code's tangential formulation, and the shear
+/// cell (derived stiffness, LIGGGHTS).
 fn linear_spring_cases(out: &mut Vec<Case>) {
     use crate::scene::NormalLaw;
     let forms = [("derived", NormalLaw::Hooke { characteristic_velocity: 1.0 }), ("given", NormalLaw::HookeStiffness { kn: SPRING_KN, kt: SPRING_KT })];
@@ -329,18 +331,26 @@ fn linear_spring_cases(out: &mut Vec<Case>) {
                     let name = format!("hooke-restitution/{tag}-e{}-n{}-{}", num(e), num(n), if clamp { "clamp" } else { "free" });
                     s.description = format!("head-on glass beads r = 1 mm on the linear spring ({tag} stiffness), e = {e}, v = 1 m/s, dt = t_c/{n}, Fn clamp {}", if clamp { "on" } else { "off" });
                     let curve = n == 500.0 && e == 0.5 && !clamp;
-                    out.push(Case::new(name, s, vec![Code::Liggghts, Code::Lammps], true).with_curve(curve));
+                    // YADE's ViscElPhys law always clamps.
+                    let codes = if clamp { vec![Code::Liggghts, Code::Yade, Code::Lammps] } else { vec![Code::Liggghts, Code::Lammps] };
+                    out.push(Case::new(name, s, codes, true).with_curve(curve));
                 }
             }
         }
     }
     for &a in &ANGLES {
         for (target, law) in [("wall", forms[0].1), ("pair", forms[1].1)] {
-            let mut s = if target == "wall" { oblique_wall(a, TangentialSpec::TotalDisplacement) } else { oblique_pair(a, TangentialSpec::TotalDisplacement) };
-            s.model.normal = law;
-            let name = format!("hooke-oblique-{target}/history-a{}", num(a));
-            s.description = format!("{} on the linear spring ({} stiffness)", s.description, if target == "wall" { "derived" } else { "given" });
-            out.push(Case::new(name, s, vec![Code::Liggghts], a == 45.0));
+            for (form, code, tag) in [(TangentialSpec::TotalDisplacement, Code::Liggghts, "history"), (TangentialSpec::IncrementalForce, Code::Yade, "incremental")] {
+                let mut s = if target == "wall" { oblique_wall(a, form) } else { oblique_pair(a, form) };
+                s.model.normal = law;
+                if code == Code::Yade {
+                    // YADE's ViscElPhys law (the linear spring) takes the contact point's velocity.
+                    s.model.lever_arm = LeverArm::ContactPoint;
+                }
+                let name = format!("hooke-oblique-{target}/{tag}-a{}", num(a));
+                s.description = format!("{} on the linear spring ({} stiffness)", s.description, if target == "wall" { "derived" } else { "given" });
+                out.push(Case::new(name, s, vec![code], a == 45.0));
+            }
         }
     }
     let mut s = builtin::shear();
@@ -350,6 +360,21 @@ fn linear_spring_cases(out: &mut Vec<Case>) {
     s.description = "the shear cell (built-in `shear`) on the linear spring (LIGGGHTS `model hooke`, vc = 1 m/s) with LIGGGHTS' lever arm".into();
     s.output.frames = 0;
     out.push(Case { info: CaseInfo { name: "hooke-shear/liggghts".into(), description: s.description.clone(), codes: vec![Code::Liggghts], quick: false, curve: false, ensemble: None }, scene: s });
+    // YADE puts each material's spring and dashpot in series per contact: the damping
+    // 2 |beta| sqrt(m* k) of grains of several masses is not such a series (refused by
+    // name), so the cell runs undamped (e = 1: friction alone dissipates) on the given
+    // spring.
+    let mut s = builtin::shear();
+    matched(&mut s, TangentialSpec::IncrementalForce);
+    s.model.lever_arm = LeverArm::ContactPoint;
+    s.model.normal = NormalLaw::HookeStiffness { kn: SPRING_KN, kt: SPRING_KT };
+    for m in &mut s.materials {
+        m.restitution = 1.0;
+    }
+    s.name = "hooke-shear-yade".into();
+    s.description = "the shear cell (built-in `shear`) on the given linear spring (kn = 2e5, kt = 1.5e5 N/m), undamped (e = 1), with YADE's ViscElPhys law (incremental tangential force, arm to the contact point, clamp)".into();
+    s.output.frames = 0;
+    out.push(Case { info: CaseInfo { name: "hooke-shear/yade".into(), description: s.description.clone(), codes: vec![Code::Yade], quick: false, curve: false, ensemble: None }, scene: s });
 }
 
 /// Chung & Ooi (2011)'s tests 4 and 6 (docs/benchmarks.md) in the reference codes, each

@@ -138,7 +138,9 @@ const MODULI_M: &str = "each pair of atom types' `pair_coeff I J hertz KN ...` w
 const SPRING_REFUSED_M: &str = "the derived spring where a pair of atom types, or a flat wall and a material of the free grains, meets at more than one kn (grains of several sizes or masses): LAMMPS' `hooke` takes one kn per pair of types and per wall fix";
 const SPRING_M: &str = "`hooke KN` and `tangential linear_history KT` in every pair_coeff and wall/gran fix; `damping tsuji` damps each contact with its own sqrt(m* kn), so grains of every size and mass are exact";
 const TANGENTIAL_M: &str = "LAMMPS' total-displacement history caps the total tangential force (elastic and damping) and, on slip, keeps the displacement that gives the cap with the damping; between grains it rescales the history to its length when the contact frame turns. grainlab's total_displacement caps the elastic force alone and projects the history: frictional contacts with damping (e < 1), and frictional grain pairs, differ (head-on and frictionless impacts, and a grain on a flat wall at e = 1, agree); incremental_force is YADE's law, which differs more";
-const NORMAL_Y: &str = "the linear spring (hooke, hooke_stiffness) is not exported to YADE yet: its linear laws (CundallStrack, ViscElPhys) take stiffness and damping in other terms, a mapping not yet checked against grainlab";
+const NORMAL_Y: &str = "hertz: FrictMat and Ip2_FrictMat_FrictMat_MindlinPhys; hooke, hooke_stiffness: ViscElMat(kn, ks, cn, cs) per material and per flat wall (KN, KS, CN, CS, WALL_*), which Ip2_ViscElMat_ViscElMat_ViscElPhys puts in series per contact, solved by grainlab from its pairs' kn, kt, 2 |beta| sqrt(m* k), and Law2_ScGeom_ViscElPhys_Basic";
+const SPRING_REFUSED_Y: &str = "a pair of materials (or a flat wall and a material) whose contacts meet at more than one stiffness or damping rate (the derived spring, or damping, of grains of several sizes or masses), or whose values no per-material values in series give: YADE's ViscElMat gives each body one spring and one dashpot, and a contact the two in series";
+const SPRING_Y: &str = "the KN, KS (and CN, CS) lists of ViscElMat: twice the pair's value for a material's own grains, the series partner for a flat wall (grainlab's kn, kt per pair, as derived or given)";
 const SPRING_L: &str = "`fix m5 kn`, `fix m6 kt` per pair of atom types, and the damping rates gamman, gammat = -2 beta(e) sqrt(k / m*) (LIGGGHTS multiplies them by m*)";
 const SPRING_REFUSED_L: &str = "a pair of materials that meets at more than one reduced mass (grains of two sizes, or a grain and a flat wall): hooke/stiffness takes one damping rate per pair of atom types, times m*";
 const SPIN_NO_ROTATION: &str = "a non-zero spin with model.rotation = false (and friction): grainlab's grain-grain contacts then leave the spin out of the contact velocity, LIGGGHTS and LAMMPS (`nve`) and YADE (blocked rotation) keep the spin, which never changes, in it";
@@ -290,25 +292,25 @@ pub const FIELDS: &[Field] = &[
         "model.normal",
         written("`pair_style gran model hertz` (hertz), `model hooke` (hooke), `model hooke/stiffness` (hooke_stiffness), in the pair style and the wall/gran fixes")
             .or_refused(SPRING_REFUSED_L),
-        refused(NORMAL_Y),
+        written(NORMAL_Y).or_refused(SPRING_REFUSED_Y),
     )
     .in_lammps(written("`hertz` (hertz) or `hooke` (hooke, hooke_stiffness) in every pair_coeff and wall/gran fix").or_refused(SPRING_REFUSED_M)),
     each(
         "model.normal.hooke.characteristic_velocity",
         written("`fix m5 all property/global characteristicVelocity scalar VC` (LIGGGHTS derives kn = kt from it per contact, as grainlab does)"),
-        refused(NORMAL_Y),
+        written(SPRING_Y),
     )
     .in_lammps(written("kn = kt of each pair of types and each wall fix, derived by grainlab from VC, E*, R* and m* (LIGGGHTS' formula): `hooke KN` and `tangential linear_history KT`").or_refused(SPRING_REFUSED_M)),
     each(
         "model.normal.hooke_stiffness.kn",
         written(SPRING_L).or_refused(SPRING_REFUSED_L),
-        refused(NORMAL_Y),
+        written(SPRING_Y),
     )
     .in_lammps(written(SPRING_M)),
     each(
         "model.normal.hooke_stiffness.kt",
         written(SPRING_L).or_refused(SPRING_REFUSED_L),
-        refused(NORMAL_Y),
+        written(SPRING_Y),
     )
     .in_lammps(written(SPRING_M)),
     each(
@@ -336,10 +338,10 @@ pub const FIELDS: &[Field] = &[
     .in_lammps(written("`limit_damping` in every pair_coeff and wall/gran fix: the total normal force clamped at 0, as grainlab's clamp")),
     each(
         "model.lever_arm",
-        differs("radius, yade", "LIGGGHTS' arm is r - dn/2, in the torque and in the contact velocity (lever_arm radius_minus_half_overlap); torques and tangential velocities differ by O(dn/r)"),
-        differs("radius, radius_minus_half_overlap", "YADE's ScGeom kinematics are lever_arm yade (full radii for the spins in the contact velocity, its translational part scaled by (r1 + r2) / (r1 + r2 - dn), torque arm r - dn/2, r - dn on a wall); torques and tangential velocities differ by O(dn/r)"),
+        differs("radius, yade, contact_point", "LIGGGHTS' arm is r - dn/2, in the torque and in the contact velocity (lever_arm radius_minus_half_overlap); torques and tangential velocities differ by O(dn/r)"),
+        differs("radius, radius_minus_half_overlap, contact_point (Hertz), yade (linear spring)", "YADE's Mindlin law (Hertz) has the ScGeom kinematics of lever_arm yade (full radii for the spins in the contact velocity, its translational part scaled by (r1 + r2) / (r1 + r2 - dn), torque arm r - dn/2, r - dn on a wall); its ViscElPhys law (the linear spring) the contact point's, lever_arm contact_point (r - dn/2 between grains, r - dn on a wall, in the velocity and the torque); torques and tangential velocities differ by O(dn/r)"),
     )
-    .in_lammps(differs("radius, radius_minus_half_overlap, yade", "LAMMPS' arms are r in the contact velocity and r - dn/2 in the torque between grains, r in both on a wall/gran plane: lever_arm radius for a grain on a flat wall, no grainlab variant for grain pairs; torques and tangential velocities of frictional grain pairs differ by O(dn/r)")),
+    .in_lammps(differs("radius, radius_minus_half_overlap, yade, contact_point", "LAMMPS' arms are r in the contact velocity and r - dn/2 in the torque between grains, r in both on a wall/gran plane: lever_arm radius for a grain on a flat wall, no grainlab variant for grain pairs; torques and tangential velocities of frictional grain pairs differ by O(dn/r)")),
     each(
         "model.rolling",
         written("cdt, epsd2: `rolling_friction cdt` or `rolling_friction epsd2` in the pair style and the wall/gran fixes (LIGGGHTS scales a grain's spin on a wall by (r - dn/2)/(r - dn) for EPSD2, which grainlab does with lever_arm radius_minus_half_overlap)")

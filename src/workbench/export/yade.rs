@@ -6,6 +6,11 @@
 //! `NewtonIntegrator(damping = 0)`, flat walls as `wall` bodies with
 //! `Ig2_Wall_Sphere_ScGeom(hertzian = True)` (R* = r, m* = m). The restitution is never
 //! passed as `en`, which YADE maps through a different damping fit (reference-notes.md).
+//! The linear spring: `ViscElMat(kn, ks, cn, cs)` per material and per flat wall, which
+//! `Ip2_ViscElMat_ViscElMat_ViscElPhys` puts in series per contact, and
+//! `Law2_ScGeom_ViscElPhys_Basic` (incremental tangential force, Fn clamped at 0, arms to
+//! the contact point), the values solved from grainlab's pairs or refused by name
+//! ([`spring_materials`]).
 //!
 //! The scene name enters comments only, escaped ([`super::escaped`]). What the script
 //! cannot express is refused and what it expresses approximately is noted, both as
@@ -15,7 +20,7 @@ use std::fmt::Write as _;
 
 use super::fields::{differs_line, note, refuse};
 use super::liggghts::name_of;
-use super::common::{Code, escaped, f};
+use super::common::{Code, contact_kinds, escaped, f};
 use super::prepare::{Exported, pressure};
 use crate::error::Error;
 use crate::physics::contact::LeverArm;
@@ -24,14 +29,14 @@ use crate::physics::walls::{Control, Surface};
 use crate::scene::{Analysis, Scene, TangentialSpec};
 
 pub(crate) fn deck(scene: &Scene, ex: &Exported) -> Result<String, Error> {
-    match scene.model.normal {
-        crate::scene::NormalLaw::Hertz => {}
-        crate::scene::NormalLaw::Hooke { characteristic_velocity } => return Err(refuse(Code::Yade, "model.normal.hooke.characteristic_velocity", characteristic_velocity, "")),
-        crate::scene::NormalLaw::HookeStiffness { kn, kt } => return Err(refuse(Code::Yade, "model.normal.hooke_stiffness.kn", kn, &format!("with model.normal.hooke_stiffness.kt = {kt}"))),
-    }
     let model = &scene.model;
     let mats = &scene.materials;
-    if let Some(k) = mats.iter().position(|m| m.restitution != mats[0].restitution) {
+    // The linear spring: ViscElMat and its law; Hertz: FrictMat and Mindlin's law, with
+    // one betan for every pair.
+    let spring = if model.normal.is_hertz() { None } else { Some(spring_materials(scene, ex)?) };
+    if spring.is_none()
+        && let Some(k) = mats.iter().position(|m| m.restitution != mats[0].restitution)
+    {
         return Err(refuse(Code::Yade, &format!("materials[{k}].restitution"), mats[k].restitution, &format!("materials[0].restitution = {}", mats[0].restitution)));
     }
     let pairs: Vec<PairMaterial> = mats.iter().flat_map(|a| mats.iter().map(move |b| PairMaterial::mix(a, b))).collect();
@@ -66,7 +71,9 @@ pub(crate) fn deck(scene: &Scene, ex: &Exported) -> Result<String, Error> {
     if !model.limit_force {
         let _ = writeln!(w, "{}", differs_line(Code::Yade, "model.limit_force", false));
     }
-    if model.lever_arm != LeverArm::Yade && !frictionless {
+    // Mindlin's law takes ScGeom's ratcheting-corrected velocity; ViscElPhys' the contact point's.
+    let arm = if spring.is_some() { LeverArm::ContactPoint } else { LeverArm::Yade };
+    if model.lever_arm != arm && !frictionless {
         let _ = writeln!(w, "{}", differs_line(Code::Yade, "model.lever_arm", name_of(&model.lever_arm)));
     }
     for wall in walls.iter().filter(|w| w.is_flat()) {
@@ -80,15 +87,35 @@ pub(crate) fn deck(scene: &Scene, ex: &Exported) -> Result<String, Error> {
         let _ = writeln!(w, "# Differs: grains under a force at t = 0: {}", note(Code::Yade, "walls.top.control.pressure"));
     }
     let _ = writeln!(w, "import math, sys");
-    let _ = writeln!(w, "E = [{}]", mats.iter().map(|m| f(m.youngs_modulus)).collect::<Vec<_>>().join(", "));
-    let _ = writeln!(w, "NU = [{}]", mats.iter().map(|m| f(m.poisson_ratio)).collect::<Vec<_>>().join(", "));
-    let _ = writeln!(w, "RHO = [{}]", mats.iter().map(|m| f(m.density)).collect::<Vec<_>>().join(", "));
-    let _ = writeln!(w, "MU = [{}]", mats.iter().map(|m| f(if frictionless { 0.0 } else { m.friction })).collect::<Vec<_>>().join(", "));
-    let _ = writeln!(w, "BETA = {}  # sqrt(5/6) |ln e| / sqrt(ln^2 e + pi^2)", f(beta));
+    let list = |v: &mut dyn Iterator<Item = f64>| v.map(f).collect::<Vec<_>>().join(", ");
+    if spring.is_none() {
+        let _ = writeln!(w, "E = [{}]", list(&mut mats.iter().map(|m| m.youngs_modulus)));
+        let _ = writeln!(w, "NU = [{}]", list(&mut mats.iter().map(|m| m.poisson_ratio)));
+    }
+    let _ = writeln!(w, "RHO = [{}]", list(&mut mats.iter().map(|m| m.density)));
+    let _ = writeln!(w, "MU = [{}]", list(&mut mats.iter().map(|m| if frictionless { 0.0 } else { m.friction })));
+    if let Some(sm) = &spring {
+        let _ = writeln!(w, "# The linear spring: each material's (and flat wall's) kn, ks (N/m), cn, cs (kg/s), which YADE puts in series per");
+        let _ = writeln!(w, "# contact (k1 k2 / (k1 + k2); 0: the other's), solved by grainlab from its pairs' kn, kt, 2 |beta| sqrt(m* k).");
+        for (name, k) in [("KN", 0), ("KS", 1), ("CN", 2), ("CS", 3)] {
+            let _ = writeln!(w, "{name} = [{}]", list(&mut sm.grains.iter().map(|g| g[k])));
+        }
+        for (name, k) in [("WALL_KN", 0), ("WALL_KS", 1), ("WALL_CN", 2), ("WALL_CS", 3)] {
+            let _ = writeln!(w, "{name} = [{}]", list(&mut sm.walls.iter().map(|g| g[k])));
+        }
+        let _ = writeln!(w, "WALL_MAT = [{}]  # each wall's material (its friction)", walls.iter().map(|wl| wl.material.to_string()).collect::<Vec<_>>().join(", "));
+    } else {
+        let _ = writeln!(w, "BETA = {}  # sqrt(5/6) |ln e| / sqrt(ln^2 e + pi^2)", f(beta));
+    }
     let _ = writeln!(w, "DT = {}\nSTEPS = {}", f(info.time_step_s), info.steps);
     let record = !ex.bench && info.analysis != Analysis::None;
     let _ = writeln!(w, "RECORD = {}  # False in a timing deck", if record { "True" } else { "False" });
-    let _ = writeln!(w, "{}", COMMON);
+    if spring.is_some() {
+        let common = edited(COMMON, MATS_HERTZ, MATS_SPRING);
+        let _ = writeln!(w, "{}", edited(&common, LAW_HERTZ, LAW_SPRING));
+    } else {
+        let _ = writeln!(w, "{}", COMMON);
+    }
     // Without rotation (and with friction: frictionless grains never spin) the free
     // grains' spin is blocked too.
     let no_spin = if model.rotation || frictionless {
@@ -155,15 +182,24 @@ pub(crate) fn deck(scene: &Scene, ex: &Exported) -> Result<String, Error> {
     if !no_spin.is_empty() {
         let _ = writeln!(w, "{no_spin}");
     }
-    for wall in walls {
+    for (j, wall) in walls.iter().enumerate() {
         if let Surface::Flat = wall.surface {
-            let _ = writeln!(w, "b = O.bodies.append(wall({}, axis=1, sense={}, material=mats[{}]))", f(wall.y), if wall.side > 0.0 { 1 } else { -1 }, wall.material);
+            let material = if spring.is_some() { format!("wmats[{j}]") } else { format!("mats[{}]", wall.material) };
+            let _ = writeln!(w, "b = O.bodies.append(wall({}, axis=1, sense={}, material={material}))", f(wall.y), if wall.side > 0.0 { 1 } else { -1 });
             let _ = writeln!(w, "O.bodies[b].state.vel = Vector3({}, 0, 0)", f(wall.v.x));
         }
     }
     let _ = writeln!(w, "{}", IMPACT);
     Ok(s)
 }
+
+/// The materials of the Hertz deck's [`COMMON`], and the linear spring's in their place.
+const MATS_HERTZ: &str = "mats = [O.materials.append(FrictMat(young=E[k], poisson=NU[k], density=RHO[k], frictionAngle=math.atan(MU[k]))) for k in range(len(E))]\n";
+const MATS_SPRING: &str = "mats = [O.materials.append(ViscElMat(kn=KN[k], ks=KS[k], cn=CN[k], cs=CS[k], density=RHO[k], frictionAngle=math.atan(MU[k]))) for k in range(len(RHO))]
+wmats = [O.materials.append(ViscElMat(kn=WALL_KN[j], ks=WALL_KS[j], cn=WALL_CN[j], cs=WALL_CS[j], density=1.0, frictionAngle=math.atan(MU[WALL_MAT[j]]))) for j in range(len(WALL_KN))]\n";
+/// The contact law of the Hertz deck's [`COMMON`], and the linear spring's in its place.
+const LAW_HERTZ: &str = "        [Ip2_FrictMat_FrictMat_MindlinPhys(betan=BETA, betas=BETA)],\n        [Law2_ScGeom_MindlinPhys_Mindlin()],\n";
+const LAW_SPRING: &str = "        [Ip2_ViscElMat_ViscElMat_ViscElPhys()],\n        [Law2_ScGeom_ViscElPhys_Basic()],\n";
 
 const COMMON: &str = r#"mats = [O.materials.append(FrictMat(young=E[k], poisson=NU[k], density=RHO[k], frictionAngle=math.atan(MU[k]))) for k in range(len(E))]
 def grains():
@@ -326,3 +362,190 @@ O.run(STEPS, True)
 print('grainlab-loop-seconds %.6f' % (time.time() - t0))
 out.close()
 sys.exit(0)"#;
+
+/// The linear spring's per-material parameters in YADE: `ViscElMat(kn, ks, cn, cs)`, which
+/// `Ip2_ViscElMat_ViscElMat_ViscElPhys` (YADE 2023.02a, with kn, ks, cn, cs given and no
+/// tc, en, et) combines per contact as springs and dashpots in series, `k = k1 k2 / (k1 +
+/// k2)`, a 0 standing for none (the contact takes the other body's value); the bodies'
+/// masses do not enter. Each of grainlab's pair values (kn, kt, and the damping rates
+/// `gn = 2 |beta| sqrt(m* kn)`, `gt = 2 |beta| sqrt(m* kt)`) must therefore be one number
+/// per pair of materials, and each material's (and each flat wall's) number is solved
+/// from them and checked against every pair: grains of one size per material, or
+/// undamped given springs (e = 1) of any sizes, are exact; the rest is refused by name.
+struct SpringMaterials {
+    /// `[kn, ks, cn, cs]` of each scene material's grains (N/m, N/m, kg/s, kg/s).
+    grains: Vec<[f64; 4]>,
+    /// The same of each wall (used by the flat ones).
+    walls: Vec<[f64; 4]>,
+}
+
+/// The quantities of [`SpringMaterials`], as a refusal names them.
+const SPRING_QUANTITIES: [&str; 4] = ["normal stiffness", "tangential stiffness", "normal damping rate", "tangential damping rate"];
+
+/// Two of YADE's per-body values in series (`Ip2_ViscElMat_ViscElMat_ViscElPhys`: a 0
+/// is no element, the other's value is the contact's).
+fn in_series(a: f64, b: f64) -> f64 {
+    let s = if a != 0.0 { 1.0 / a } else { 0.0 } + if b != 0.0 { 1.0 / b } else { 0.0 };
+    if s != 0.0 { 1.0 / s } else { 0.0 }
+}
+
+/// The value `x` whose series with `known` is `target`, if there is one.
+fn series_partner(target: f64, known: f64) -> Option<f64> {
+    let same = |x: f64, m: f64| (x - m).abs() <= 1e-12 * m.abs();
+    if known == 0.0 {
+        Some(target)
+    } else if same(target, known) {
+        Some(0.0)
+    } else if target > 0.0 && target < known {
+        Some(1.0 / (1.0 / target - 1.0 / known))
+    } else {
+        None
+    }
+}
+
+fn spring_materials(scene: &Scene, ex: &Exported) -> Result<SpringMaterials, Error> {
+    use crate::physics::contact::damping::{Damping, LinearRestitution};
+    let e = ex.built.engine.as_ref();
+    let mats = &scene.materials;
+    let n = mats.len();
+    let law = scene.model.normal;
+    let refused = |detail: String| refuse(Code::Yade, "model.normal", law.name(), &detail);
+    let same = |x: f64, m: f64| (x - m).abs() <= 1e-12 * m.abs();
+    let mut grains = vec![[0.0; 4]; n];
+    let mut walls = vec![[0.0; 4]; e.walls().len()];
+    for (q, what) in SPRING_QUANTITIES.iter().enumerate() {
+        // grainlab's value of a contact of materials a and b at (m*, R*).
+        let value = |a: usize, b: usize, m: f64, r: f64| {
+            let pm = PairMaterial::mix(&mats[a], &mats[b]);
+            let st = law.stiffness(&pm, r, m, 0.0);
+            let (gn, gt) = LinearRestitution::coefficients(&pm, m.sqrt(), &st);
+            [st.kn, st.kt, gn.abs(), gt.abs()][q]
+        };
+        let kinds = contact_kinds(n, e.particles(), e.walls(), value);
+        let pair = |a: usize, b: usize| -> Result<Option<f64>, Error> {
+            match kinds.pairs[a * n + b][..] {
+                [] => Ok(None),
+                [v] => Ok(Some(v)),
+                _ => Err(refused(format!("the grains of materials[{a}] and materials[{b}] meet at more than one {what} (grains of several sizes or masses), which YADE's per-material values in series cannot give"))),
+            }
+        };
+        // Each material from its grains' contacts with one another (two equal values in
+        // series), then the others from a contact with a material already known.
+        let mut known: Vec<Option<f64>> = (0..n).map(|a| pair(a, a).map(|v| v.map(|v| 2.0 * v))).collect::<Result<_, _>>()?;
+        loop {
+            let mut progress = false;
+            for a in 0..n {
+                for b in 0..n {
+                    if let (Some(va), None, Some(t)) = (known[a], known[b], pair(a, b)?) {
+                        known[b] = Some(series_partner(t, va).ok_or_else(|| refused(format!("no {what} of materials[{b}] in series with that of materials[{a}] gives their contacts' {t:e}")))?);
+                        progress = true;
+                    }
+                }
+            }
+            if !progress {
+                // A material that meets others but none known: start from it.
+                match (0..n).flat_map(|a| (0..n).map(move |b| (a, b))).find(|&(a, b)| known[a].is_none() && known[b].is_none() && !kinds.pairs[a * n + b].is_empty()) {
+                    Some((a, b)) => known[a] = Some(2.0 * pair(a, b)?.expect("listed")),
+                    None => break,
+                }
+            }
+        }
+        for a in 0..n {
+            grains[a][q] = known[a].unwrap_or(0.0);
+        }
+        for a in 0..n {
+            for b in 0..n {
+                if let Some(t) = pair(a, b)? {
+                    let got = in_series(grains[a][q], grains[b][q]);
+                    if !(same(got, t) || got == t) {
+                        return Err(refused(format!("the grains of materials[{a}] and materials[{b}] would meet at the {what} {got:e} in YADE, {t:e} in grainlab")));
+                    }
+                }
+            }
+        }
+        // Each flat wall from its contacts with the free grains of each material.
+        for (j, per) in kinds.walls.iter().enumerate() {
+            let mut wall: Option<f64> = None;
+            for (a, list) in per.iter().enumerate() {
+                let t = match list[..] {
+                    [] => continue,
+                    [t] => t,
+                    _ => return Err(refused(format!("the free grains of materials[{a}] meet walls.{} at more than one {what} (grains of several sizes or masses)", e.walls()[j].name))),
+                };
+                let w = match wall {
+                    Some(w) => w,
+                    None => *wall.insert(series_partner(t, grains[a][q]).ok_or_else(|| refused(format!("no {what} of walls.{} in series with that of materials[{a}] gives their contacts' {t:e}", e.walls()[j].name)))?),
+                };
+                let got = in_series(grains[a][q], w);
+                if !(same(got, t) || got == t) {
+                    return Err(refused(format!("the free grains of materials[{a}] would meet walls.{} at the {what} {got:e} in YADE, {t:e} in grainlab", e.walls()[j].name)));
+                }
+            }
+            walls[j][q] = wall.unwrap_or(0.0);
+        }
+    }
+    Ok(SpringMaterials { grains, walls })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::NormalLaw;
+
+    #[test]
+    fn series_partners_give_the_target_back_in_series() {
+        for (target, known) in [(1.0, 3.0), (2.5e5, 4e5), (0.3, 0.3), (7.0, 0.0), (0.0, 0.0)] {
+            let x = series_partner(target, known).unwrap();
+            let got = in_series(known, x);
+            assert!((got - target).abs() <= 1e-15 * target, "{target} {known}: {x} gives {got}");
+        }
+        // Nothing in series is stiffer than either element (a 0 is no element).
+        assert_eq!(series_partner(4.0, 3.0), None);
+        assert_eq!(series_partner(0.0, 3.0), None);
+    }
+
+    fn spring(scene: &Scene) -> Result<SpringMaterials, Error> {
+        let ex = super::super::prepare::prepare(scene, Code::Yade, &crate::scene::limits::Limits::machine())?;
+        spring_materials(scene, &ex)
+    }
+
+    #[test]
+    fn the_spring_of_two_materials_and_a_wall_is_solved_exactly_and_polydisperse_damping_refused() {
+        // Two grains of two materials (different moduli and restitutions) hitting each
+        // other: one pair, whose four values the two materials' series gives back.
+        let mut s = crate::scene::builtin::builtin("collision").unwrap();
+        s.model.normal = NormalLaw::Hooke { characteristic_velocity: 1.0 };
+        s.materials.push(crate::physics::material::Material { youngs_modulus: 200e9, restitution: 0.5, ..s.materials[0].clone() });
+        if let crate::scene::Grains::List(l) = &mut s.grains {
+            l[1].material = 1;
+        }
+        let sm = spring(&s).unwrap();
+        let pm = PairMaterial::mix(&s.materials[0], &s.materials[1]);
+        let ex = super::super::prepare::prepare(&s, Code::Yade, &crate::scene::limits::Limits::machine()).unwrap();
+        let p = ex.built.engine.particles();
+        let (m, r) = (crate::physics::material::reduced(p.m[0], p.m[1]), crate::physics::material::reduced(p.r[0], p.r[1]));
+        let kn = s.model.normal.stiffness(&pm, r, m, 0.0).kn;
+        let gn = 2.0 * pm.beta.abs() * (m * kn).sqrt();
+        for (q, want) in [(0, kn), (1, kn), (2, gn), (3, gn)] {
+            let got = in_series(sm.grains[0][q], sm.grains[1][q]);
+            assert!((got - want).abs() <= 1e-14 * want, "{}: {got} vs {want}", SPRING_QUANTITIES[q]);
+        }
+        // The oblique impact: a grain on flat walls, the wall's values from the grain's.
+        let mut s = crate::scene::builtin::builtin("oblique").unwrap();
+        s.model.normal = NormalLaw::HookeStiffness { kn: 2e5, kt: 1.5e5 };
+        let sm = spring(&s).unwrap();
+        assert!((in_series(sm.grains[0][1], sm.walls[0][1]) - 1.5e5).abs() <= 1e-9);
+        // A damped spring in a packing of several sizes: refused by name; undamped, exact.
+        let mut s = crate::scene::builtin::shear_cell(60, 0.004);
+        s.model.normal = NormalLaw::HookeStiffness { kn: 2e5, kt: 1.5e5 };
+        let e = spring(&s).err().expect("refused").to_string();
+        assert!(e.contains("model.normal = hooke_stiffness") && e.contains("damping rate"), "{e}");
+        s.materials[0].restitution = 1.0;
+        let sm = spring(&s).unwrap();
+        assert_eq!(sm.grains[0], [4e5, 3e5, 0.0, 0.0]);
+        // The derived spring of several sizes: refused (kn differs from pair to pair).
+        s.model.normal = NormalLaw::Hooke { characteristic_velocity: 1.0 };
+        let e = spring(&s).err().expect("refused").to_string();
+        assert!(e.contains("model.normal = hooke") && e.contains("normal stiffness"), "{e}");
+    }
+}

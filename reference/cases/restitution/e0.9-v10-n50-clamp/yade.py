@@ -3,7 +3,7 @@
 # Run in this directory: yade -n -x yade.py (reads grains.data, writes series.txt).
 # Recorded between the contact law and the integrator: positions x(n), force F(x(n)), velocities v(n-1/2).
 # Differs: model.tangential = total_displacement: YADE's Mindlin law adds force increments; head-on impacts agree, oblique ones differ (rebound spin up to 2x)
-# Differs: model.lever_arm = radius_minus_half_overlap: YADE's ScGeom kinematics are lever_arm yade (full radii for the spins in the contact velocity, its translational part scaled by (r1 + r2) / (r1 + r2 - dn), torque arm r - dn/2, r - dn on a wall); torques and tangential velocities differ by O(dn/r)
+# Differs: model.lever_arm = radius_minus_half_overlap: YADE's Mindlin law (Hertz) has the ScGeom kinematics of lever_arm yade (full radii for the spins in the contact velocity, its translational part scaled by (r1 + r2) / (r1 + r2 - dn), torque arm r - dn/2, r - dn on a wall); its ViscElPhys law (the linear spring) the contact point's, lever_arm contact_point (r - dn/2 between grains, r - dn on a wall, in the velocity and the torque); torques and tangential velocities differ by O(dn/r)
 import math, sys
 E = [6.30000000000000000e10]
 NU = [2.00000000000000011e-1]
