@@ -58,6 +58,8 @@ fn contact_kernel(c: &mut Criterion) {
         spin: 1e-4,
         dt: 5.8e-8,
         tangential_scale: 1.0,
+        roll: 0.0,
+        roll_scale: 1.0,
     };
     let options = ModelOptions { limit_force: false, lever_arm: LeverArm::Radius };
     let mut ledger = EnergyLedger::default();
@@ -78,10 +80,13 @@ fn contact_kernel(c: &mut Criterion) {
             spin: Lanes::splat(input.spin),
             dt: Lanes::splat(input.dt),
             tangential_scale: Lanes::splat(1.0),
+            roll: Lanes::splat(0.0),
+            roll_scale: Lanes::splat(1.0),
         };
         let pml = PairMaterial::gather([&pm; 4]);
         let xi = grainlab::physics::dim::Vec2::zeros();
-        let mut h = <grainlab::physics::contact::tangential::TotalDisplacement as grainlab::physics::contact::tangential::Tangential>::gather([&xi; 4]);
+        // The contact's state: (tangential history, rolling state), () without rolling resistance.
+        let mut h = (<grainlab::physics::contact::tangential::TotalDisplacement as grainlab::physics::contact::tangential::Tangential>::gather([&xi; 4]), ());
         c.bench_function("contact_kernel_liggghts_history_four_lanes", |b| b.iter(|| l.force(black_box(&lanes), &pml, &mut h)));
     }
     let y = YadeMindlin::new(options, Hertz);

@@ -79,7 +79,7 @@ impl Variant {
                 Variant::Tangential(TangentialSpec::Frictionless),
             ],
             "clamp" => vec![Variant::Clamp(false), Variant::Clamp(true)],
-            "lever" => vec![Variant::Lever(LeverArm::Radius), Variant::Lever(LeverArm::RadiusMinusHalfOverlap), Variant::Lever(LeverArm::Yade)],
+            "lever" => vec![Variant::Lever(LeverArm::Radius), Variant::Lever(LeverArm::RadiusMinusHalfOverlap), Variant::Lever(LeverArm::Yade), Variant::Lever(LeverArm::ContactPoint)],
             _ => {
                 return Err(Error::BadOption { option: "--variants".into(), value: name.into(), allowed: "tangential, clamp, lever".into() });
             }

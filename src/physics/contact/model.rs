@@ -212,13 +212,10 @@ pub struct EnergyMemory<R: Real = f64, X = ()> {
     pub rolling: X,
 }
 
-impl<X: Copy> EnergyMemory<f64, X> {
+impl<X: Copy + RollingEnergy<f64>> EnergyMemory<f64, X> {
     /// The memory of a contact that goes on after its sums were taken: its previous
     /// values, sums 0 (the rolling work included).
-    pub fn restarted(&self) -> Self
-    where
-        X: RollingEnergy<f64>,
-    {
+    pub fn restarted(&self) -> Self {
         let mut rolling = self.rolling;
         rolling.take();
         EnergyMemory { sums: EnergySums::default(), rolling, ..*self }
