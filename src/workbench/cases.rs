@@ -353,6 +353,27 @@ fn linear_spring_cases(out: &mut Vec<Case>) {
             }
         }
     }
+    // Two materials against YADE, whose per-material springs and dashpots in series the
+    // exporter solves: a second material (E = 200 GPa, nu = 0.3, e = 0.5, mu = 0.3, glass'
+    // density) for the resting grain (given spring), and for the flat walls (derived).
+    let second = Material { name: "second".into(), youngs_modulus: 200e9, poisson_ratio: 0.3, restitution: 0.5, friction: 0.3, ..glass(0.9) };
+    for (target, law) in [("wall", forms[0].1), ("pair", forms[1].1)] {
+        let form = TangentialSpec::IncrementalForce;
+        let mut s = if target == "wall" { oblique_wall(30.0, form) } else { oblique_pair(30.0, form) };
+        s.model.normal = law;
+        s.model.lever_arm = LeverArm::ContactPoint;
+        s.materials.push(second.clone());
+        if target == "wall" {
+            let w = s.walls.as_mut().expect("flat walls");
+            w.bottom.material = 1;
+            w.top.material = 1;
+        } else if let crate::scene::Grains::List(l) = &mut s.grains {
+            l[1].material = 1;
+        }
+        let name = format!("hooke-oblique-{target}/incremental-2mat-a30");
+        s.description = format!("{} on the linear spring ({} stiffness), the {} of a second material (E = 200 GPa, e = 0.5, mu = 0.3)", s.description, if target == "wall" { "derived" } else { "given" }, if target == "wall" { "walls" } else { "resting grain" });
+        out.push(Case::new(name, s, vec![Code::Yade], true));
+    }
     let mut s = builtin::shear();
     s.model.lever_arm = LeverArm::RadiusMinusHalfOverlap;
     s.model.normal = NormalLaw::Hooke { characteristic_velocity: 1.0 };
