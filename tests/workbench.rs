@@ -133,7 +133,7 @@ fn lammps_matches_to_rounding_where_its_contact_model_is_grainlab_s() {
     rows.extend(spring);
     for prefix in ["oblique-wall/lammps", "oblique-pair/lammps-frictionless"] {
         let oblique = check_all(prefix, Code::Lammps);
-        assert_eq!(oblique.len(), 8 * 5, "{prefix}: 7 angles and the two-material case");
+        assert_eq!(oblique.len(), 7 * 5, "{prefix}");
         rows.extend(oblique);
     }
     // grainlab's Tsuji damping (model.damping = "tsuji") is LAMMPS' `damping tsuji` with
