@@ -343,10 +343,7 @@ fn linear_spring_cases(out: &mut Vec<Case>) {
             for (form, code, tag) in [(TangentialSpec::TotalDisplacement, Code::Liggghts, "history"), (TangentialSpec::IncrementalForce, Code::Yade, "incremental")] {
                 let mut s = if target == "wall" { oblique_wall(a, form) } else { oblique_pair(a, form) };
                 s.model.normal = law;
-                if code == Code::Yade {
-                    // YADE's ViscElPhys law (the linear spring) takes the contact point's velocity.
-                    s.model.lever_arm = LeverArm::ContactPoint;
-                }
+                matched(&mut s, form);
                 let name = format!("hooke-oblique-{target}/{tag}-a{}", num(a));
                 s.description = format!("{} on the linear spring ({} stiffness)", s.description, if target == "wall" { "derived" } else { "given" });
                 out.push(Case::new(name, s, vec![code], a == 45.0));
@@ -361,7 +358,7 @@ fn linear_spring_cases(out: &mut Vec<Case>) {
         let form = TangentialSpec::IncrementalForce;
         let mut s = if target == "wall" { oblique_wall(30.0, form) } else { oblique_pair(30.0, form) };
         s.model.normal = law;
-        s.model.lever_arm = LeverArm::ContactPoint;
+        matched(&mut s, form);
         s.materials.push(second.clone());
         if target == "wall" {
             let w = s.walls.as_mut().expect("flat walls");
@@ -386,9 +383,8 @@ fn linear_spring_cases(out: &mut Vec<Case>) {
     // name), so the cell runs undamped (e = 1: friction alone dissipates) on the given
     // spring.
     let mut s = builtin::shear();
-    matched(&mut s, TangentialSpec::IncrementalForce);
-    s.model.lever_arm = LeverArm::ContactPoint;
     s.model.normal = NormalLaw::HookeStiffness { kn: SPRING_KN, kt: SPRING_KT };
+    matched(&mut s, TangentialSpec::IncrementalForce);
     for m in &mut s.materials {
         m.restitution = 1.0;
     }
@@ -462,13 +458,14 @@ pub fn protocol_case() -> Scene {
 }
 
 /// Settings matched to the code that uses each tangential formulation: LIGGGHTS' lever
-/// arm r - dn/2 and no clamp (its defaults); YADE's ratcheting-free kinematics and the
-/// clamp it always applies.
+/// arm r - dn/2 and no clamp (its defaults); YADE's kinematics for the scene's normal law
+/// (Mindlin's ratcheting-free ones, ViscElPhys' contact point) and the clamp it always
+/// applies.
 fn matched(s: &mut Scene, form: TangentialSpec) {
     s.model.tangential = form;
     let yade = form == TangentialSpec::IncrementalForce;
     s.model.limit_force = yade;
-    s.model.lever_arm = if yade { LeverArm::Yade } else { LeverArm::RadiusMinusHalfOverlap };
+    s.model.lever_arm = if yade { crate::workbench::export::yade::lever_arm(&s.model.normal) } else { LeverArm::RadiusMinusHalfOverlap };
 }
 
 /// A glass bead (r = 1 mm, e = 0.9, mu = 0.5) hitting a flat glass wall at 1 m/s, `a` degrees from the normal.

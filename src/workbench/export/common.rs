@@ -125,6 +125,11 @@ pub(crate) fn f(v: f64) -> String {
     format!("{v:.17e}")
 }
 
+/// Two per-contact values the decks take as one (within 1e-12 relative; 0 only equals 0).
+pub(crate) fn same_value(x: f64, m: f64) -> bool {
+    (x - m).abs() <= 1e-12 * m.abs()
+}
+
 /// What a deck needs of the contacts each pair of materials can make: the distinct values
 /// (to 1e-12) of `key(a, b, m*, R*)` over the contacts between grains of materials a and
 /// b, indexed `[a * n + b]` (both orders), and of `key(wall material, a, m, r)` over each
@@ -144,7 +149,7 @@ pub(crate) struct ContactKinds {
 }
 
 pub(crate) fn contact_kinds(n: usize, p: &crate::physics::particles::Particles, walls: &[crate::physics::walls::Wall], key: impl Fn(usize, usize, f64, f64) -> f64) -> ContactKinds {
-    let same = |x: f64, m: f64| (x - m).abs() <= 1e-12 * m.abs();
+    let same = same_value;
     let add = |list: &mut Vec<f64>, k: f64| {
         if list.len() < 2 && !list.iter().any(|&v| same(k, v)) {
             list.push(k);

@@ -354,7 +354,7 @@ fn spring_rates(scene: &Scene, p: &crate::physics::particles::Particles, walls: 
     // The reduced masses each pair of types meets at: grain pairs, and grains on flat
     // walls (m* = m), whose wall/gran fixes share the pair style's table.
     let kinds = super::common::contact_kinds(n, p, walls, |_, _, m_star, _| m_star);
-    let same = |x: f64, m: f64| (x - m).abs() <= 1e-12 * m;
+    let same = super::common::same_value;
     let mut stars: Vec<Vec<f64>> = vec![Vec::new(); n * n];
     let mut add = |a: usize, b: usize, m: f64| {
         for (x, y) in [(a, b), (b, a)] {

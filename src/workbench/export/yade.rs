@@ -20,7 +20,7 @@ use std::fmt::Write as _;
 
 use super::fields::{differs_line, note, refuse};
 use super::liggghts::name_of;
-use super::common::{Code, contact_kinds, escaped, f};
+use super::common::{Code, contact_kinds, escaped, f, same_value};
 use super::prepare::{Exported, pressure};
 use crate::error::Error;
 use crate::physics::contact::LeverArm;
@@ -71,9 +71,7 @@ pub(crate) fn deck(scene: &Scene, ex: &Exported) -> Result<String, Error> {
     if !model.limit_force {
         let _ = writeln!(w, "{}", differs_line(Code::Yade, "model.limit_force", false));
     }
-    // Mindlin's law takes ScGeom's ratcheting-corrected velocity; ViscElPhys' the contact point's.
-    let arm = if spring.is_some() { LeverArm::ContactPoint } else { LeverArm::Yade };
-    if model.lever_arm != arm && !frictionless {
+    if model.lever_arm != lever_arm(&model.normal) && !frictionless {
         let _ = writeln!(w, "{}", differs_line(Code::Yade, "model.lever_arm", name_of(&model.lever_arm)));
     }
     for wall in walls.iter().filter(|w| w.is_flat()) {
@@ -191,6 +189,13 @@ pub(crate) fn deck(scene: &Scene, ex: &Exported) -> Result<String, Error> {
     }
     let _ = writeln!(w, "{}", IMPACT);
     Ok(s)
+}
+
+/// The lever arm of YADE's law for the normal law `normal`: Mindlin's (Hertz) takes
+/// ScGeom's ratcheting-corrected velocity (`yade`), ViscElPhys' (the linear spring) the
+/// contact point's (`contact_point`).
+pub fn lever_arm(normal: &crate::scene::NormalLaw) -> LeverArm {
+    if normal.is_hertz() { LeverArm::Yade } else { LeverArm::ContactPoint }
 }
 
 /// The materials of the Hertz deck's [`COMMON`], and the linear spring's in their place.
@@ -391,10 +396,9 @@ fn in_series(a: f64, b: f64) -> f64 {
 
 /// The value `x` whose series with `known` is `target`, if there is one.
 fn series_partner(target: f64, known: f64) -> Option<f64> {
-    let same = |x: f64, m: f64| (x - m).abs() <= 1e-12 * m.abs();
     if known == 0.0 {
         Some(target)
-    } else if same(target, known) {
+    } else if same_value(target, known) {
         Some(0.0)
     } else if target > 0.0 && target < known {
         Some(1.0 / (1.0 / target - 1.0 / known))
@@ -410,7 +414,6 @@ fn spring_materials(scene: &Scene, ex: &Exported) -> Result<SpringMaterials, Err
     let n = mats.len();
     let law = scene.model.normal;
     let refused = |detail: String| refuse(Code::Yade, "model.normal", law.name(), &detail);
-    let same = |x: f64, m: f64| (x - m).abs() <= 1e-12 * m.abs();
     let mut grains = vec![[0.0; 4]; n];
     let mut walls = vec![[0.0; 4]; e.walls().len()];
     for (q, what) in SPRING_QUANTITIES.iter().enumerate() {
@@ -457,7 +460,7 @@ fn spring_materials(scene: &Scene, ex: &Exported) -> Result<SpringMaterials, Err
             for b in 0..n {
                 if let Some(t) = pair(a, b)? {
                     let got = in_series(grains[a][q], grains[b][q]);
-                    if !(same(got, t) || got == t) {
+                    if !same_value(got, t) {
                         return Err(refused(format!("the grains of materials[{a}] and materials[{b}] would meet at the {what} {got:e} in YADE, {t:e} in grainlab")));
                     }
                 }
@@ -477,7 +480,7 @@ fn spring_materials(scene: &Scene, ex: &Exported) -> Result<SpringMaterials, Err
                     None => *wall.insert(series_partner(t, grains[a][q]).ok_or_else(|| refused(format!("no {what} of walls.{} in series with that of materials[{a}] gives their contacts' {t:e}", e.walls()[j].name)))?),
                 };
                 let got = in_series(grains[a][q], w);
-                if !(same(got, t) || got == t) {
+                if !same_value(got, t) {
                     return Err(refused(format!("the free grains of materials[{a}] would meet walls.{} at the {what} {got:e} in YADE, {t:e} in grainlab", e.walls()[j].name)));
                 }
             }
