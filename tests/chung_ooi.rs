@@ -104,12 +104,12 @@ impl Drop for Rows {
     }
 }
 
+/// The three frictional formulations: LIGGGHTS', YADE's and LAMMPS' (the cap on the total
+/// tangential force, issue 32).
+const FORMS: [TangentialSpec; 3] = [TangentialSpec::TotalDisplacement, TangentialSpec::IncrementalForce, TangentialSpec::TotalForceCap];
+
 fn form_name(form: TangentialSpec) -> &'static str {
-    match form {
-        TangentialSpec::TotalDisplacement => "total_displacement",
-        TangentialSpec::IncrementalForce => "incremental_force",
-        TangentialSpec::Frictionless => "frictionless",
-    }
+    form.name()
 }
 
 fn rel(a: f64, b: f64) -> f64 {
@@ -229,7 +229,7 @@ fn test_4_oblique_impacts_at_constant_speed() {
     // damping's share (the capped elastic force plus damping while sticking: issue 32).
     let mat = material(380e9, 0.23, 4000.0, 0.98, 0.092);
     let mut rows = Rows::new("test_4");
-    for form in [TangentialSpec::TotalDisplacement, TangentialSpec::IncrementalForce] {
+    for form in FORMS {
         for (shape, kappa) in shapes() {
             for a in (1..=17).map(|k| 5.0 * k as f64) {
                 let t = a.to_radians();
@@ -244,7 +244,17 @@ fn test_4_oblique_impacts_at_constant_speed() {
                 rows.add(shape, form_name(form), a, "spin_r_over_v", imp.rebound_spin_rad_s * 2.5e-3 / 3.9, spin);
                 // Clear of the threshold by 10%: near it the slip reaches zero within the
                 // last steps (the disk at 30 degrees, 3% above it, misses by 6e-5).
-                if t.tan() >= (1.0 + kappa) * 0.092 * (1.0 + e) * 1.1 {
+                if t.tan() >= (1.0 + kappa) * 0.092 * (1.0 + e) * 1.1 && form == TangentialSpec::TotalForceCap {
+                    // LAMMPS' law keeps the dashpot's force in the spring on slip, and
+                    // Hertz's kt grows while loading: the spring then pushes along the
+                    // slip and the contact sticks for a few steps, so the friction impulse
+                    // falls short of mu J (measured: 1.3e-5 to 5.0e-5 here, e = 0.98), and
+                    // never exceeds it (the clamp holds Fn >= 0, so each step's friction
+                    // force is at most mu Fn).
+                    let (dvt, dw_r, closed, _) = gross_sliding(&s, &imp, kappa, 0.092);
+                    assert!((-1e-4..1e-12).contains(&(dvt / closed - 1.0)), "{what}: dvt {dvt} vs -mu dvn {closed}");
+                    assert!(rel(dw_r, kappa * dvt) < 1e-9, "{what}: r dw {dw_r} vs kappa dvt {}", kappa * dvt);
+                } else if t.tan() >= (1.0 + kappa) * 0.092 * (1.0 + e) * 1.1 {
                     assert_gross_sliding(&s, &imp, kappa, 0.092, &what);
                     let et = imp.restitution_tangential.unwrap();
                     let closed = (1.0 + kappa) * 0.092 * (1.0 + e) / t.tan() - 1.0;
@@ -264,7 +274,7 @@ fn test_5_constant_normal_and_varying_tangential_velocity() {
     // (undamped: no attractive force, no clamp needed), mu = 0.3: sliding throughout
     // when tan(angle) >= (1 + kappa) mu (1 + e) = 2.1 (sphere), 1.8 (disk).
     let mat = material(208e9, 0.3, 7850.0, 1.0, 0.3);
-    for form in [TangentialSpec::TotalDisplacement, TangentialSpec::IncrementalForce] {
+    for form in FORMS {
         for (shape, kappa) in shapes() {
             for a in [65.0f64, 70.0, 75.0, 80.0, 85.0] {
                 let t = a.to_radians();
@@ -288,7 +298,7 @@ fn test_6_varying_initial_spin() {
     // -mu dvn sign(w0) and the spin drop kappa mu dvn / r.
     let mat = material(70e9, 0.33, 2700.0, 0.5, 0.4);
     let mut rows = Rows::new("test_6");
-    for form in [TangentialSpec::TotalDisplacement, TangentialSpec::IncrementalForce] {
+    for form in FORMS {
         for (shape, kappa) in shapes() {
             for ratio in [-10.0, -4.0, 3.0, 5.0, 10.0] {
                 let s = on_plane(mat.clone(), shape, 0.1, 0.2, 0.0, ratio * 0.2 / 0.1, 500.0, form, true);
@@ -302,12 +312,26 @@ fn test_6_varying_initial_spin() {
                 // force resists the approach from the first step, so the cap mu |Fn| starts
                 // above the elastic tangential force and the contact sticks at first, when
                 // the tangential damping -gt vt adds to it (measured excess: 7.4-8.8% with
-                // total displacement, 13-14% with incremental force). Issue 32's law caps
-                // the total. Asserted: the excess is that known one (0 to 15%) and the
-                // spin follows the tangential impulse (r dw = kappa dvt) to rounding.
+                // total displacement, 13-14% with incremental force). Asserted: the excess
+                // is that known one (0 to 15%) and the spin follows the tangential impulse
+                // (r dw = kappa dvt) to rounding.
                 let (dvt, dw_r, closed, _) = gross_sliding(&s, &imp, kappa, 0.4);
                 let excess = dvt / closed - 1.0;
-                assert!((0.0..0.15).contains(&excess), "{what}: friction impulse {excess:e} above mu J");
+                if form == TangentialSpec::TotalForceCap {
+                    // LAMMPS' law caps the total, so the impulse never exceeds mu J (the
+                    // clamp holds Fn >= 0); but it keeps the dashpot's force in the spring
+                    // on slip, and Hertz's kt (and gt, as sqrt(kt)) grow while loading: the
+                    // spring then pushes along the slip and the contact sticks for a while,
+                    // 9.2-15.4% short of mu J (measured). With the linear spring (kt and gt
+                    // constant) nothing is left over and the identities hold to rounding.
+                    assert!((-0.2..1e-12).contains(&excess), "{what}: friction impulse {excess:e} from mu J");
+                    let mut s = on_plane(mat.clone(), shape, 0.1, 0.2, 0.0, ratio * 0.2 / 0.1, 500.0, form, true);
+                    s.model.normal = NormalLaw::HookeStiffness { kn: 2e8, kt: 1.5e8 };
+                    let imp = run(&s);
+                    assert_gross_sliding(&s, &imp, kappa, 0.4, &format!("{what}, the given spring"));
+                } else {
+                    assert!((0.0..0.15).contains(&excess), "{what}: friction impulse {excess:e} above mu J");
+                }
                 assert!(rel(dw_r, kappa * dvt) < 1e-9, "{what}: r dw {dw_r} vs kappa dvt {}", kappa * dvt);
                 // Undamped (e = 1), the contact slides from the first step and the
                 // identities hold to rounding.
@@ -327,7 +351,7 @@ fn test_7_two_equal_spheres_with_opposite_spins_feel_no_tangential_force() {
     // (r w + r (-w) = 0), so there is no tangential force at all: the spins and the
     // tangential velocities come out exactly as they went in, for both formulations.
     let mat = material(70e9, 0.33, 2700.0, 0.5, 0.4);
-    for form in [TangentialSpec::TotalDisplacement, TangentialSpec::IncrementalForce] {
+    for form in FORMS {
         for (shape, _) in shapes() {
             let mut s = pair((0.1, mat.clone()), (0.1, mat.clone()), shape, 0.4, 0.0, [3.0, -3.0], 500.0, true);
             s.model.tangential = form;
@@ -346,7 +370,7 @@ fn test_8_a_small_sphere_on_a_larger_denser_one() {
     // identities; with e = 1 (no damping) they do to the turning of the line of centres.
     let small = material(70e9, 0.33, 2700.0, 0.5, 0.4);
     let large = Material { density: 27000.0, ..small.clone() };
-    for form in [TangentialSpec::TotalDisplacement, TangentialSpec::IncrementalForce] {
+    for form in FORMS {
         for (shape, kappa) in shapes() {
             for w in [-40.0, 40.0] {
                 let mut s = pair((0.05, small.clone()), (0.1, large.clone()), shape, 0.2, 0.0, [w, 0.0], 500.0, true);
@@ -368,7 +392,13 @@ fn test_8_a_small_sphere_on_a_larger_denser_one() {
                 // (measured 7.4% total displacement, 13% incremental force): asserted
                 // within 0 to 15%, and the spin following the tangential impulse.
                 let excess = dvt / (-slip * 0.4 * dvn) - 1.0;
-                assert!((0.0..0.15).contains(&excess), "{what}: friction impulse {excess:e} above mu J");
+                if form == TangentialSpec::TotalForceCap {
+                    // LAMMPS' law: at most mu J (within the 1e-3 of the turning line of
+                    // centres), short of it as in test 6 (measured 9.2%).
+                    assert!((-0.2..1e-3).contains(&excess), "{what}: friction impulse {excess:e} from mu J");
+                } else {
+                    assert!((0.0..0.15).contains(&excess), "{what}: friction impulse {excess:e} above mu J");
+                }
                 assert!(rel(dw * r, kappa * dvt) < 1e-3, "{what}: r dw {} vs kappa dvt {}", dw * r, kappa * dvt);
                 assert_eq!(dw.signum(), -slip, "{what}: the spin slows");
                 let e1 = |m: &Material| Material { restitution: 1.0, ..m.clone() };

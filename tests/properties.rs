@@ -160,24 +160,29 @@ fn lanes_match_alone<N: grainlab::physics::contact::normal::Normal, D: grainlab:
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(300))]
     #[test]
-    fn four_lanes_give_each_contact_its_own_bits(c0 in contact(), c1 in contact(), c2 in contact(), c3 in contact(), clamp in any::<bool>(), lever in 0usize..4) {
+    fn four_lanes_give_each_contact_its_own_bits(c0 in contact(), c1 in contact(), c2 in contact(), c3 in contact(), clamp in any::<bool>(), lever in 0usize..5) {
         use grainlab::physics::contact::LeverArm;
-        use grainlab::physics::contact::tangential::{IncrementalForce, IncrementalState, TotalDisplacement};
+        use grainlab::physics::contact::tangential::{IncrementalForce, IncrementalState, TotalDisplacement, TotalForceCap};
         use grainlab::physics::contact::damping::{LinearRestitution, TsujiFit, Viscoelastic};
         use grainlab::physics::contact::normal::{Hertz, Hooke};
         use grainlab::physics::contact::rolling::{Cdt, Epsd2, RollingMemory, Sds};
-        let lever = [LeverArm::Radius, LeverArm::RadiusMinusHalfOverlap, LeverArm::Yade, LeverArm::ContactPoint][lever];
+        let lever = [LeverArm::Radius, LeverArm::RadiusMinusHalfOverlap, LeverArm::Yade, LeverArm::ContactPoint, LeverArm::Lammps][lever];
         let cs = [c0, c1, c2, c3];
         let v = |v: &Vec2| vec![v.x.to_bits(), v.y.to_bits()];
         let incremental = |c: &[f64; 9]| IncrementalState { force: Vec2::new(c[5], c[6]) * 1e3, n_prev: Vec2::new(c[7].cos(), c[7].sin()) };
         let incremental_bits = |h: &IncrementalState| [v(&h.force), v(&h.n_prev)].concat();
         lanes_match_alone::<Hertz, Viscoelastic, TotalDisplacement, NoRolling>(Hertz, NoRolling, &cs, clamp, lever, |c| Vec2::new(c[5], c[6]), v, |_| (), |_| vec![], |_| (), |_| vec![])?;
         lanes_match_alone::<Hertz, Viscoelastic, IncrementalForce, NoRolling>(Hertz, NoRolling, &cs, clamp, lever, incremental, incremental_bits, |_| (), |_| vec![], |_| (), |_| vec![])?;
+        // LAMMPS' law: a history off the tangent line (the frame turn, a select lane by
+        // lane), sticking and sliding, with the restitution damping and Tsuji's.
+        lanes_match_alone::<Hertz, Viscoelastic, TotalForceCap, NoRolling>(Hertz, NoRolling, &cs, clamp, lever, |c| Vec2::new(c[5], c[6]), v, |_| (), |_| vec![], |_| (), |_| vec![])?;
+        lanes_match_alone::<Hertz, TsujiFit, TotalForceCap, NoRolling>(Hertz, NoRolling, &cs, clamp, lever, |c| Vec2::new(c[5], c[6]), v, |_| (), |_| vec![], |_| (), |_| vec![])?;
         // The linear spring, derived per pair (a fifth root lane by lane) and given.
         for spring in [Hooke::Derived { vc: 0.8 }, Hooke::Given { kn: 3e5, kt: 2e5 }] {
             lanes_match_alone::<Hooke, LinearRestitution, TotalDisplacement, NoRolling>(spring, NoRolling, &cs, clamp, lever, |c| Vec2::new(c[5], c[6]), v, |_| (), |_| vec![], |_| (), |_| vec![])?;
             lanes_match_alone::<Hooke, LinearRestitution, IncrementalForce, NoRolling>(spring, NoRolling, &cs, clamp, lever, incremental, incremental_bits, |_| (), |_| vec![], |_| (), |_| vec![])?;
             lanes_match_alone::<Hooke, TsujiFit, TotalDisplacement, NoRolling>(spring, NoRolling, &cs, clamp, lever, |c| Vec2::new(c[5], c[6]), v, |_| (), |_| vec![], |_| (), |_| vec![])?;
+            lanes_match_alone::<Hooke, LinearRestitution, TotalForceCap, NoRolling>(spring, NoRolling, &cs, clamp, lever, |c| Vec2::new(c[5], c[6]), v, |_| (), |_| vec![], |_| (), |_| vec![])?;
         }
         // Rolling resistance: the constant torque (a sign lane by lane), the torque
         // spring and LAMMPS' SDS, from states below and beyond their caps.

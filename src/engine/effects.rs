@@ -96,6 +96,7 @@ impl Effects {
         let friction = scene.model.tangential != TangentialSpec::Frictionless && rubbing.is_some();
         let form = match scene.model.tangential {
             TangentialSpec::TotalDisplacement => "total displacement (LIGGGHTS' history)",
+            TangentialSpec::TotalForceCap => "total displacement, cap on the total force (LAMMPS' history)",
             TangentialSpec::IncrementalForce => "incremental force (YADE's)",
             TangentialSpec::Frictionless => "none",
         };

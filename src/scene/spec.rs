@@ -307,10 +307,28 @@ pub enum TangentialSpec {
     /// LIGGGHTS `tangential history`.
     #[default]
     TotalDisplacement,
+    /// LAMMPS `pair granular ... tangential mindlin` (Hertz) or `linear_history` (the
+    /// linear spring): a total displacement like LIGGGHTS', but the Coulomb cap holds the
+    /// total tangential force, damping included, and the history is rescaled to its
+    /// length when the contact frame turns. The friction impulse of a sliding contact is
+    /// exactly mu times the normal one.
+    TotalForceCap,
     /// YADE `Law2_ScGeom_MindlinPhys_Mindlin`.
     IncrementalForce,
     /// No tangential force (and no spin).
     Frictionless,
+}
+
+impl TangentialSpec {
+    /// The name a scene gives it.
+    pub fn name(self) -> &'static str {
+        match self {
+            TangentialSpec::TotalDisplacement => "total_displacement",
+            TangentialSpec::TotalForceCap => "total_force_cap",
+            TangentialSpec::IncrementalForce => "incremental_force",
+            TangentialSpec::Frictionless => "frictionless",
+        }
+    }
 }
 
 /// Rolling resistance (`model.rolling`): a torque against the relative spin w_i - w_j

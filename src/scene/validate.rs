@@ -171,7 +171,7 @@ impl Scene {
             let w = m.work_of_adhesion;
             let at = format!("materials[{k}]");
             let compiled = crate::physics::contact::model::COMPILED;
-            check(self.model.tangential != TangentialSpec::IncrementalForce, &at, "work_of_adhesion", w, &format!("0 with model.tangential = incremental_force (compiled: {compiled})"))?;
+            check(matches!(self.model.tangential, TangentialSpec::TotalDisplacement | TangentialSpec::Frictionless), &at, "work_of_adhesion", w, &format!("0 with model.tangential = {} (compiled: {compiled})", self.model.tangential.name()))?;
             check(!tsuji, &at, "work_of_adhesion", w, &format!("0 with model.damping = tsuji (compiled: {compiled})"))?;
             check(!self.model.limit_force, &at, "work_of_adhesion", w, "0 with model.limit_force = true (the clamp Fn >= 0 would remove the attraction; LAMMPS refuses limit_damping with dmt too)")?;
         }

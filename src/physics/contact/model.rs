@@ -13,7 +13,7 @@ use super::cohesion::{Cohesion, Dmt, NoCohesion};
 use super::rolling::{Cdt, Epsd2, InLanes, NoRolling, Rolling, RollingEnergy, RollingInput, Sds};
 use super::damping::{Damping, LinearRestitution, TsujiFit, Undamped, Viscoelastic};
 use super::normal::{Hertz, Hooke, Normal};
-use super::tangential::{Frictionless, IncrementalForce, Tangential, TangentialForce, TangentialInput, TotalDisplacement};
+use super::tangential::{Frictionless, IncrementalForce, Tangential, TangentialForce, TangentialInput, TotalDisplacement, TotalForceCap};
 use crate::physics::dim::Vec2;
 use crate::physics::energy::{EnergyLedger, EnergySums};
 use crate::physics::lanes::{Real, k, pick};
@@ -41,6 +41,11 @@ pub enum LeverArm {
     /// (the centre projected onto the wall): YADE 2023's `Law2_ScGeom_ViscElPhys_Basic`,
     /// the linear spring's law there (no ratcheting correction).
     ContactPoint,
+    /// LAMMPS 20220106's `pair granular` and `fix wall/gran granular`: the radius r in the
+    /// contact velocity (pairs and walls), r - dn/2 in a pair's torque, r in a wall's.
+    /// Not energy-consistent between grains: the work of the tangential force and of its
+    /// torques differ by O(dn/r).
+    Lammps,
 }
 
 impl LeverArm {
@@ -48,7 +53,7 @@ impl LeverArm {
     #[inline(always)]
     pub fn arm<R: Real>(self, r: R, dn: R) -> R {
         match self {
-            LeverArm::Radius | LeverArm::Yade => r,
+            LeverArm::Radius | LeverArm::Yade | LeverArm::Lammps => r,
             LeverArm::RadiusMinusHalfOverlap | LeverArm::ContactPoint => r - k::<R>(0.5) * dn,
         }
     }
@@ -65,7 +70,7 @@ impl LeverArm {
     pub fn torque_arm<R: Real>(self, r: R, dn: R) -> R {
         match self {
             LeverArm::Radius => r,
-            LeverArm::RadiusMinusHalfOverlap | LeverArm::Yade | LeverArm::ContactPoint => r - k::<R>(0.5) * dn,
+            LeverArm::RadiusMinusHalfOverlap | LeverArm::Yade | LeverArm::ContactPoint | LeverArm::Lammps => r - k::<R>(0.5) * dn,
         }
     }
     /// The torque arm of a grain on a flat wall, m.
@@ -73,6 +78,7 @@ impl LeverArm {
     pub fn wall_torque_arm(self, r: f64, dn: f64) -> f64 {
         match self {
             LeverArm::Yade | LeverArm::ContactPoint => r - dn,
+            LeverArm::Lammps => r,
             _ => self.torque_arm(r, dn),
         }
     }
@@ -321,6 +327,7 @@ pub trait ContactLaw: Copy + Send + Sync + 'static {
                 (true, LeverArm::RadiusMinusHalfOverlap) => ", arm r-dn/2",
                 (true, LeverArm::Yade) => ", YADE ratcheting-free kinematics",
                 (true, LeverArm::ContactPoint) => ", arm to the contact point",
+                (true, LeverArm::Lammps) => ", LAMMPS' arms (r; r-dn/2 in a pair's torque)",
                 _ => "",
             }
         )
@@ -534,6 +541,16 @@ pub type LiggghtsHookeHistoryElastic = ContactModel<Hooke, Undamped, TotalDispla
 pub type HookeIncremental = ContactModel<Hooke, LinearRestitution, IncrementalForce>;
 pub type HookeIncrementalElastic = ContactModel<Hooke, Undamped, IncrementalForce>;
 
+/// LAMMPS `pair granular ... tangential mindlin` (Hertz) and `linear_history` (the
+/// linear spring): the cap on the total tangential force (`model.tangential =
+/// "total_force_cap"`), with the restitution damping, none, or Tsuji's.
+pub type HertzForceCap = ContactModel<Hertz, Viscoelastic, TotalForceCap>;
+pub type HertzForceCapElastic = ContactModel<Hertz, Undamped, TotalForceCap>;
+pub type HertzTsujiForceCap = ContactModel<Hertz, TsujiFit, TotalForceCap>;
+pub type HookeForceCap = ContactModel<Hooke, LinearRestitution, TotalForceCap>;
+pub type HookeForceCapElastic = ContactModel<Hooke, Undamped, TotalForceCap>;
+pub type HookeTsujiForceCap = ContactModel<Hooke, TsujiFit, TotalForceCap>;
+
 /// LAMMPS `pair granular ... damping tsuji` (`model.damping = "tsuji"`), either normal
 /// law, frictionless or with the total-displacement history.
 pub type HertzTsujiFrictionless = ContactModel<Hertz, TsujiFit, Frictionless>;
@@ -560,4 +577,4 @@ pub type HookeHistoryEpsd2 = ContactModel<Hooke, LinearRestitution, TotalDisplac
 pub type HookeHistorySds = ContactModel<Hooke, LinearRestitution, TotalDisplacement, NoCohesion, Sds>;
 
 /// The names of the compiled combinations, for a refusal.
-pub const COMPILED: &str = "normal hertz or hooke (hooke_stiffness), each with damping (beta(e); the linear spring's constant-restitution form) or none (every e = 1), and tangential total_displacement, incremental_force or frictionless; damping tsuji with either normal law, total_displacement or frictionless; cohesion (work_of_adhesion > 0) with either normal law, the restitution damping, total_displacement or frictionless, without limit_force; rolling (cdt, epsd2, sds) with either normal law, the restitution damping and total_displacement, without cohesion";
+pub const COMPILED: &str = "normal hertz or hooke (hooke_stiffness), each with damping (beta(e); the linear spring's constant-restitution form) or none (every e = 1), and tangential total_displacement, total_force_cap, incremental_force or frictionless; damping tsuji with either normal law, total_displacement, total_force_cap or frictionless; cohesion (work_of_adhesion > 0) with either normal law, the restitution damping, total_displacement or frictionless, without limit_force; rolling (cdt, epsd2, sds) with either normal law, the restitution damping and total_displacement, without cohesion";

@@ -185,3 +185,75 @@ impl Tangential for IncrementalForce {
         IncrementalState { force: crate::physics::lanes::lane2(&h.force, l), n_prev: crate::physics::lanes::lane2(&h.n_prev, l) }
     }
 }
+
+/// LAMMPS `pair granular ... tangential mindlin` (Hertz) and `tangential linear_history`
+/// (the linear spring), as its 20220106 release computes them: a total tangential
+/// displacement `xi` whose Coulomb cap is on the *total* tangential force, damping
+/// included. Each step, when the history's part along the normal would give a force above
+/// 1e-10 of the cap (the contact frame has turned), `xi` is projected onto the tangent
+/// line and rescaled to its old length; then `xi += vt dt` and `Ft = -kt xi - gt vt`.
+/// When `|Ft| > mu |Fn|` the force is scaled to the cap and `xi = -(Ft + gt vt)/kt`, the
+/// displacement whose spring gives the capped force together with the damping (a contact
+/// whose history is exactly 0 then has no tangential force, as in LAMMPS). The friction
+/// impulse of a sliding contact is then exactly mu times the normal one, so the
+/// gross-sliding closed forms hold (tests/total_force_cap.rs).
+///
+/// The split for the energy ledger: elastic `-kt xi`, viscous `-gt vt` (which still acts
+/// while sliding); friction takes what a slip removes from the spring, `kt (|xi_trial|^2
+/// - |xi|^2) / 2` when positive. A slip that stores the dashpot's force in the spring
+/// loads it instead: that energy is the law's own work (`W_t`, [`crate::physics::energy`]),
+/// as the work of a kt that changes under a loaded spring is.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct TotalForceCap;
+
+impl Tangential for TotalForceCap {
+    const NAME: &'static str = "TotalForceCapHistory";
+    const FRICTION: bool = true;
+    /// The tangential displacement xi, m.
+    type History<R: Real> = Vector2<R>;
+    type Saved = Vector2<f64>;
+    fn save(xi: Vector2<f64>) -> Vector2<f64> {
+        xi
+    }
+    fn load(xi: Vector2<f64>) -> Vector2<f64> {
+        xi
+    }
+    #[inline(always)]
+    fn force<R: Real>(xi: &mut Vector2<R>, inp: &TangentialInput<R>) -> TangentialForce<R> {
+        let n = inp.n;
+        // The frame turn: onto the tangent line, at the old length (0 if nothing is left).
+        let along = xi.dot(&n);
+        let turned = (along.simd_abs() * inp.kt).simd_gt(k::<R>(1e-10) * inp.cap);
+        let length = xi.norm();
+        let projected = *xi - n * along;
+        let left = projected.norm();
+        let rescale = pick(left.simd_gt(R::zero()), length / left, R::zero());
+        *xi = pick2(turned, projected * rescale, *xi);
+        *xi += inp.vt * inp.dt;
+        let damping = inp.vt * -inp.gt;
+        let trial = *xi * -inp.kt + damping;
+        let f = trial.norm();
+        // cap >= 0, so a sliding contact has f > 0.
+        let slide = f.simd_gt(inp.cap);
+        let held = xi.norm_squared().simd_gt(R::zero());
+        let capped = trial * (inp.cap / f);
+        let xi_slid = (capped - damping) * (-R::one() / inp.kt);
+        let before = xi.norm_squared();
+        // Sliding with a history: the capped force; sliding without one: no force at all.
+        *xi = pick2(slide & held, xi_slid, *xi);
+        // What the slip takes out of the spring; a slip that loads it (the dashpot's force
+        // put in) is the law's own work, which the ledger counts in W_t.
+        let slip_energy = pick(slide & held, (k::<R>(0.5) * inp.kt * (before - xi.norm_squared())).simd_max(R::zero()), R::zero());
+        let elastic = *xi * -inp.kt;
+        let none = slide & !held;
+        TangentialForce { elastic: pick2(none, Vector2::zeros(), elastic), damping: pick2(none, Vector2::zeros(), damping), slip_energy }
+    }
+    #[inline(always)]
+    fn gather(h: [&Vector2<f64>; crate::physics::lanes::LANES]) -> Vector2<crate::physics::lanes::Lanes> {
+        crate::physics::lanes::gather2(|l| *h[l])
+    }
+    #[inline(always)]
+    fn lane(h: &Vector2<crate::physics::lanes::Lanes>, l: usize) -> Vector2<f64> {
+        crate::physics::lanes::lane2(h, l)
+    }
+}
