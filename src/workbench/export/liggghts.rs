@@ -53,14 +53,16 @@ pub(crate) fn deck(scene: &Scene, ex: &Exported, code: Code) -> Result<String, E
     let _ = writeln!(w, "# Grains: spheres at z = 0 in a 3D box (the sphere-in-plane model); nothing moves them out of the plane.");
     let frictional = model.tangential != TangentialSpec::Frictionless;
     if lammps {
-        // LAMMPS' arms and history agree with grainlab's radius and total displacement
-        // only for one grain on flat walls, and its history only without damping.
+        // LAMMPS' arms are lever_arm lammps, and radius for one grain on flat walls; its
+        // history is total_force_cap, and total_displacement for one grain on flat walls
+        // without damping.
         let pairs = p.len() > 1;
-        if frictional && (pairs || model.lever_arm != LeverArm::Radius) {
+        if frictional && model.lever_arm != LeverArm::Lammps && (pairs || model.lever_arm != LeverArm::Radius) {
             let _ = writeln!(w, "{}", differs_line(code, "model.lever_arm", name_of(&model.lever_arm)));
         }
         let damped = mats.iter().any(|m| m.restitution < 1.0);
-        if model.tangential == TangentialSpec::IncrementalForce || (frictional && (pairs || damped)) {
+        let history_alike = model.tangential == TangentialSpec::TotalDisplacement && !pairs && !damped;
+        if model.tangential == TangentialSpec::IncrementalForce || (frictional && model.tangential != TangentialSpec::TotalForceCap && !history_alike) {
             let _ = writeln!(w, "{}", differs_line(code, "model.tangential", name_of(&model.tangential)));
         }
         // LAMMPS 20220106's DMT friction cap (docs/fidelity.md).
@@ -71,7 +73,7 @@ pub(crate) fn deck(scene: &Scene, ex: &Exported, code: Code) -> Result<String, E
         if model.lever_arm != LeverArm::RadiusMinusHalfOverlap && frictional {
             let _ = writeln!(w, "{}", differs_line(code, "model.lever_arm", name_of(&model.lever_arm)));
         }
-        if model.tangential == TangentialSpec::IncrementalForce {
+        if matches!(model.tangential, TangentialSpec::IncrementalForce | TangentialSpec::TotalForceCap) {
             let _ = writeln!(w, "{}", differs_line(code, "model.tangential", name_of(&model.tangential)));
         }
     }
