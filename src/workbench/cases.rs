@@ -182,6 +182,39 @@ fn lammps_cases(out: &mut Vec<Case>) {
     }
     tsuji_cases(out);
     dmt_cases(out);
+    force_cap_cases(out);
+}
+
+/// LAMMPS' own tangential law (`model.tangential = "total_force_cap"`, lever arm
+/// `lammps`), where the other formulations differ from it by design: frictional impacts
+/// with damping on a flat wall and on a resting grain (glass, e = 0.9 and 0.5, mu = 0.5,
+/// 1 m/s, 5 to 85 degrees), with the clamp at e = 0.5, and the linear spring (given, on
+/// the pair). t_c/200. `oblique-wall/forcecap-*`, `oblique-pair/forcecap-*`,
+/// `hooke-oblique-pair/forcecap-*`.
+fn force_cap_cases(out: &mut Vec<Case>) {
+    let cap = |s: &mut Scene, clamp: bool| {
+        s.model.tangential = TangentialSpec::TotalForceCap;
+        s.model.lever_arm = LeverArm::Lammps;
+        s.model.limit_force = clamp;
+    };
+    for &a in &ANGLES {
+        for (e, clamp, tag) in [(0.9, false, ""), (0.5, true, "-clamp-e0.5")] {
+            let mut s = builtin::oblique(glass(e), 1e-3, 1.0, a, TangentialSpec::TotalForceCap, 200.0);
+            cap(&mut s, clamp);
+            let clamped = if clamp { ", Fn >= 0" } else { "" };
+            s.description = format!("glass bead on a flat glass wall at 1 m/s, {a} deg from the normal, e = {e}, mu = 0.5{clamped}, LAMMPS' tangential law and arms, t_c/200");
+            out.push(Case::new(format!("oblique-wall/forcecap{tag}-a{}", num(a)), s, vec![Code::Lammps], a == 45.0));
+            let mut s = builtin::oblique_pair(glass(e), 1e-3, 1.0, a, TangentialSpec::TotalForceCap, 200.0);
+            cap(&mut s, clamp);
+            s.description = format!("glass bead on a resting one at 1 m/s, {a} deg from the line of centres, e = {e}, mu = 0.5{clamped}, LAMMPS' tangential law and arms, t_c/200");
+            out.push(Case::new(format!("oblique-pair/forcecap{tag}-a{}", num(a)), s, vec![Code::Lammps], a == 45.0));
+        }
+        let mut s = builtin::oblique_pair(glass(0.5), 1e-3, 1.0, a, TangentialSpec::TotalForceCap, 200.0);
+        s.model.normal = crate::scene::NormalLaw::HookeStiffness { kn: SPRING_KN, kt: SPRING_KT };
+        cap(&mut s, false);
+        s.description = format!("glass bead on a resting one at 1 m/s, {a} deg from the line of centres, the given spring (kn = {SPRING_KN} N/m, kt = {SPRING_KT} N/m), e = 0.5, mu = 0.5, LAMMPS' tangential law and arms, t_c/200");
+        out.push(Case::new(format!("hooke-oblique-pair/forcecap-a{}", num(a)), s, vec![Code::Lammps], a == 45.0));
+    }
 }
 
 /// The rolling friction coefficient of the `rolling/*` cases: with mu = 0.5 the rolling
@@ -403,8 +436,7 @@ fn chung_ooi_cases(out: &mut Vec<Case>) {
     use crate::physics::dim::GrainShape;
     let al2o3 = Material { name: "Al2O3".into(), youngs_modulus: 380e9, poisson_ratio: 0.23, density: 4000.0, restitution: 0.98, friction: 0.092, work_of_adhesion: 0.0, rolling_friction: 0.0 };
     let al = Material { name: "Al".into(), youngs_modulus: 70e9, poisson_ratio: 0.33, density: 2700.0, restitution: 0.5, friction: 0.4, work_of_adhesion: 0.0, rolling_friction: 0.0 };
-    for (form, code) in [(TangentialSpec::TotalDisplacement, Code::Liggghts), (TangentialSpec::IncrementalForce, Code::Yade)] {
-        let tag = if code == Code::Liggghts { "history" } else { "incremental" };
+    for (form, code, tag) in [(TangentialSpec::TotalDisplacement, Code::Liggghts, "history"), (TangentialSpec::IncrementalForce, Code::Yade, "incremental"), (TangentialSpec::TotalForceCap, Code::Lammps, "forcecap")] {
         for a in [5.0f64, 15.0, 25.0, 35.0, 45.0, 55.0, 65.0, 75.0, 85.0] {
             let t = a.to_radians();
             let mut s = builtin::on_rigid_plane(al2o3.clone(), GrainShape::SphereInPlane, 2.5e-3, 3.9 * t.cos(), 3.9 * t.sin(), 0.0, 500.0, form);
@@ -458,14 +490,19 @@ pub fn protocol_case() -> Scene {
 }
 
 /// Settings matched to the code that uses each tangential formulation: LIGGGHTS' lever
-/// arm r - dn/2 and no clamp (its defaults); YADE's kinematics for the scene's normal law
+/// arm r - dn/2 and no clamp (its defaults); LAMMPS' arms for its law (total_force_cap),
+/// no clamp; YADE's kinematics for the scene's normal law
 /// (Mindlin's ratcheting-free ones, ViscElPhys' contact point) and the clamp it always
 /// applies.
 fn matched(s: &mut Scene, form: TangentialSpec) {
     s.model.tangential = form;
     let yade = form == TangentialSpec::IncrementalForce;
     s.model.limit_force = yade;
-    s.model.lever_arm = if yade { crate::workbench::export::yade::lever_arm(&s.model.normal) } else { LeverArm::RadiusMinusHalfOverlap };
+    s.model.lever_arm = match form {
+        TangentialSpec::IncrementalForce => crate::workbench::export::yade::lever_arm(&s.model.normal),
+        TangentialSpec::TotalForceCap => LeverArm::Lammps,
+        _ => LeverArm::RadiusMinusHalfOverlap,
+    };
 }
 
 /// A glass bead (r = 1 mm, e = 0.9, mu = 0.5) hitting a flat glass wall at 1 m/s, `a` degrees from the normal.
