@@ -105,7 +105,11 @@ impl Effects {
             (_, Some(&q)) => format!("declared: model.tangential, {form}; the {} pair has friction {}", pair_name(mats, q), mix(&q).friction),
             (_, None) => format!("derived: friction = 0 for every pair of bodies that can touch ({}), so no tangential force can arise", pairs.iter().map(|&q| pair_name(mats, q)).collect::<Vec<_>>().join(", ")),
         };
-        let measured = if scene.model.tangential == TangentialSpec::IncrementalForce { "incremental force (YADE's)" } else { "frictionless (no tangential, no spin stage)" };
+        let measured = match scene.model.tangential {
+            TangentialSpec::IncrementalForce => "incremental force (YADE's)",
+            TangentialSpec::TotalForceCap => "total force cap (LAMMPS')",
+            _ => "frictionless (no tangential, no spin stage)",
+        };
         push("friction (tangential force)", friction, friction_why, Some(measured));
         let rotation = friction && scene.model.rotation;
         let rotation_why = if !scene.model.rotation {

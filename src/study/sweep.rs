@@ -75,11 +75,12 @@ impl Variant {
         Ok(match name {
             "tangential" => vec![
                 Variant::Tangential(TangentialSpec::TotalDisplacement),
+                Variant::Tangential(TangentialSpec::TotalForceCap),
                 Variant::Tangential(TangentialSpec::IncrementalForce),
                 Variant::Tangential(TangentialSpec::Frictionless),
             ],
             "clamp" => vec![Variant::Clamp(false), Variant::Clamp(true)],
-            "lever" => vec![Variant::Lever(LeverArm::Radius), Variant::Lever(LeverArm::RadiusMinusHalfOverlap), Variant::Lever(LeverArm::Yade), Variant::Lever(LeverArm::ContactPoint)],
+            "lever" => vec![Variant::Lever(LeverArm::Radius), Variant::Lever(LeverArm::RadiusMinusHalfOverlap), Variant::Lever(LeverArm::Yade), Variant::Lever(LeverArm::ContactPoint), Variant::Lever(LeverArm::Lammps)],
             _ => {
                 return Err(Error::BadOption { option: "--variants".into(), value: name.into(), allowed: "tangential, clamp, lever".into() });
             }
