@@ -310,8 +310,8 @@ pub enum TangentialSpec {
     /// LAMMPS `pair granular ... tangential mindlin` (Hertz) or `linear_history` (the
     /// linear spring): a total displacement like LIGGGHTS', but the Coulomb cap holds the
     /// total tangential force, damping included, and the history is rescaled to its
-    /// length when the contact frame turns. The friction impulse of a sliding contact is
-    /// exactly mu times the normal one.
+    /// length when the contact frame turns. The friction impulse never exceeds mu times
+    /// the normal one (docs/model.md).
     TotalForceCap,
     /// YADE `Law2_ScGeom_MindlinPhys_Mindlin`.
     IncrementalForce,
