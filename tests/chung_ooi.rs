@@ -195,6 +195,33 @@ fn test_3_the_realised_restitution_is_the_input_one() {
     }
 }
 
+#[test]
+fn test_3_under_the_clamp_the_clamped_damping_returns_the_input_restitution() {
+    // Test 3 with the force clamp (YADE's law, LIGGGHTS `limitForce on`): beta(e) returns
+    // more than e there (closed form exp(-2 b acos(b) / sqrt(1 - b^2)), b = |beta(e)|:
+    // 0.1 gives 0.253), while model.damping = "clamped_restitution" returns the input e
+    // within the same first-order envelope 0.3 dt/t_c at t_c/1000 (tests/restitution_clamped.rs
+    // measures its convergence). e = 0.1 to 0.9, both materials and shapes.
+    let mut rows = Rows::new("test_3_clamped");
+    for mat in [material(380e9, 0.23, 4000.0, 1.0, 0.0), material(100e9, 0.25, 7000.0, 1.0, 0.0)] {
+        for (shape, _) in shapes() {
+            for e in [0.1, 0.3, 0.5, 0.7, 0.9] {
+                let grain = Material { restitution: e, ..mat.clone() };
+                let mut s = on_plane(grain.clone(), shape, 2.5e-3, 3.9, 0.0, 0.0, 1000.0, TangentialSpec::Frictionless, true);
+                s.model.damping = grainlab::scene::DampingSpec::ClampedRestitution;
+                let imp = run(&s);
+                rows.add(shape, if mat.youngs_modulus > 2e11 { "Al2O3" } else { "cast_iron" }, e, "restitution_normal", imp.restitution_normal, Some(e));
+                assert!((imp.restitution_normal - e).abs() < 0.3 / 1000.0, "E = {} {shape:?} e = {e}: realised {}", mat.youngs_modulus, imp.restitution_normal);
+                if e == 0.1 {
+                    let plain = run(&on_plane(grain, shape, 2.5e-3, 3.9, 0.0, 0.0, 1000.0, TangentialSpec::Frictionless, true));
+                    let closed = grainlab::physics::restitution::clamped_restitution(-grainlab::physics::restitution::beta(e));
+                    assert!((plain.restitution_normal - closed).abs() < 0.3 / 1000.0 && closed > 0.25, "beta(e) under the clamp: realised {}, closed form {closed}", plain.restitution_normal);
+                }
+            }
+        }
+    }
+}
+
 /// The gross-sliding identities of one impact on the plane: grain 0's tangential velocity
 /// changes by -mu times its normal velocity change (in the direction of the initial slip)
 /// and its spin by kappa / r times that; 1e-9 relative leaves room for the rounding of

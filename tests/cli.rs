@@ -94,8 +94,8 @@ fn refused_scene(name: &str, change: impl Fn(&mut Value), field: &str, range: &s
 
 #[test]
 fn bad_scenes_are_refused_with_the_field_and_the_range() {
-    refused(|s| s["materials"][0]["restitution"] = 1.5.into(), "materials[0].restitution = 1.5", "(0, 1]");
-    refused(|s| s["materials"][0]["restitution"] = 0.0.into(), "materials[0].restitution = 0", "(0, 1]");
+    refused(|s| s["materials"][0]["restitution"] = 1.5.into(), "materials[0].restitution = 1.5", "[0, 1]");
+    refused(|s| s["materials"][0]["restitution"] = (-0.1).into(), "materials[0].restitution = -0.1", "[0, 1]");
     refused(|s| s["materials"][0]["poisson_ratio"] = 0.5.into(), "materials[0].poisson_ratio = 0.5", "[0, 0.5)");
     refused(|s| s["materials"][0]["youngs_modulus"] = (-1.0).into(), "materials[0].youngs_modulus = -1", "> 0 Pa");
     refused(|s| s["materials"][0]["friction"] = (-0.1).into(), "materials[0].friction = -0.1", ">= 0");

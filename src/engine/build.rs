@@ -304,10 +304,11 @@ pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<B
     let imin = (0..n_free).min_by(|&a, &b| p.r[a].total_cmp(&p.r[b])).expect("at least one grain");
     let (r, m, i) = (p.r[imin], p.m[imin], p.inertia[imin]);
     let mat = &mats[p.material[imin] as usize];
-    let mut refs = vec![RefContact::twin(r, m, i, PairMaterial::mix(mat, mat))];
+    let rule = scene.model.beta_rule();
+    let mut refs = vec![RefContact::twin(r, m, i, PairMaterial::mix_with(mat, mat, rule))];
     // Against each flat wall, with the wall's own material.
     for w in walls.iter().filter(|w: &&Wall| w.is_flat()) {
-        refs.push(RefContact::wall(r, m, i, PairMaterial::mix(mat, &mats[w.material])));
+        refs.push(RefContact::wall(r, m, i, PairMaterial::mix_with(mat, &mats[w.material], rule)));
     }
     let ts = &scene.time_step;
     // An accuracy rule is resolved into steps per contact before the engine is built
@@ -315,7 +316,7 @@ pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<B
     if let TimeStepRule::Accuracy { .. } = ts.rule {
         return Err(Error::Scene("an accuracy time step rule must be resolved first: build the scene with grainlab::build (the study's build), which calibrates it".into()));
     }
-    let time_step = choose(&scene.model.normal, &ts.rule, ts.characteristic_speed, ts.allow_unstable, &refs, (r, m, mat), friction)?;
+    let time_step = choose(&scene.model, &ts.rule, ts.characteristic_speed, ts.allow_unstable, &refs, (r, m, mat), friction)?;
     let dt = time_step.dt_s;
     let steps = crate::engine::timestep::step_count(scene.duration, dt, "duration")?;
     // Every stage of a protocol takes at least a step.
@@ -473,7 +474,7 @@ impl Parts<'_> {
             p: self.p,
             boundary: self.boundary,
             law,
-            pair_table: PairTable::new(&scene.materials),
+            pair_table: PairTable::new(&scene.materials, scene.model.beta_rule()),
             pairs: PairList { keep_energy: E, ..Default::default() },
             walls: self.walls,
             wall_hist,

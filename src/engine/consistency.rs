@@ -320,23 +320,24 @@ pub fn stable_for_every_pair(scene: &Scene, p: &Particles, walls: &[Wall], info:
         let m = shape.mass(r, mats[k].density);
         (r, m, shape.inertia(r, m))
     };
+    let rule = scene.model.beta_rule();
     let mut refs = Vec::new();
     let mut names = Vec::new();
     for (ia, &a) in free.iter().enumerate() {
         let ga = grain(r, a);
         for &b in &free[ia..] {
-            let pair = PairMaterial::mix(&mats[a], &mats[b]);
+            let pair = PairMaterial::mix_with(&mats[a], &mats[b], rule);
             refs.push(if a == b { RefContact::twin(r, ga.1, ga.2, pair) } else { RefContact::grains(ga, grain(r, b), pair) });
             names.push(format!("materials[{a}] against materials[{b}]"));
         }
         for w in walls {
             match &w.surface {
                 Surface::Flat => {
-                    refs.push(RefContact::wall(r, ga.1, ga.2, PairMaterial::mix(&mats[a], &mats[w.material])));
+                    refs.push(RefContact::wall(r, ga.1, ga.2, PairMaterial::mix_with(&mats[a], &mats[w.material], rule)));
                     names.push(format!("materials[{a}] against the {} wall", w.name));
                 }
                 Surface::Rough { .. } if glued.contains(&w.material) => {
-                    refs.push(RefContact::grains(ga, grain(w.glued_radius, w.material), PairMaterial::mix(&mats[a], &mats[w.material])));
+                    refs.push(RefContact::grains(ga, grain(w.glued_radius, w.material), PairMaterial::mix_with(&mats[a], &mats[w.material], rule)));
                     names.push(format!("materials[{a}] against the {} wall's grains", w.name));
                 }
                 Surface::Rough { .. } => {}
@@ -344,7 +345,7 @@ pub fn stable_for_every_pair(scene: &Scene, p: &Particles, walls: &[Wall], info:
         }
     }
     let v = info.characteristic_speed_m_s;
-    let limit = |c: &RefContact| crate::engine::timestep::stability_limit(&scene.model.normal, std::slice::from_ref(c), v, friction);
+    let limit = |c: &RefContact| crate::engine::timestep::stability_limit(&scene.model, std::slice::from_ref(c), v, friction);
     let Some(k) = (0..refs.len()).min_by(|&x, &y| limit(&refs[x]).total_cmp(&limit(&refs[y]))) else { return Ok(()) };
     let worst = limit(&refs[k]);
     if !(info.dt_s <= worst) {

@@ -124,6 +124,10 @@ impl Effects {
         let tsuji = scene.model.damping == crate::scene::DampingSpec::Tsuji;
         let damping_why = match lossy {
             _ if tsuji => "declared: model.damping = tsuji (LAMMPS' fit alpha(e) sqrt(m* k); alpha(1) = 3e-4 damps e = 1 too, and the realised e is not the input e)".to_string(),
+            Some(&q) if scene.model.damping == crate::scene::DampingSpec::ClampedRestitution => {
+                let pm = PairMaterial::mix_with(&mats[q.0], &mats[q.1], scene.model.beta_rule());
+                format!("derived: the {} pair has restitution {} < 1 (declared model.damping = clamped_restitution: beta = {:.6} returns it under the clamp, against beta(e) = {:.6})", pair_name(mats, q), pm.restitution, pm.beta, crate::physics::material::beta(pm.restitution))
+            }
             Some(&q) => format!("derived: the {} pair has restitution {} < 1", pair_name(mats, q), mix(&q).restitution),
             None => "derived: restitution = 1 for every pair of bodies that can touch".to_string(),
         };

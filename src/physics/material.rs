@@ -31,7 +31,10 @@ pub struct Material {
     /// Density rho, kg/m^3, > 0. Default 2500.
     #[serde(default = "default_rho")]
     pub density: f64,
-    /// Normal coefficient of restitution e, in (0, 1]. Default 0.9.
+    /// Normal coefficient of restitution e, in [0, 1]. Default 0.9. e = 0 (perfectly
+    /// plastic) gives beta = -1, critical damping: without the clamp the grains stay
+    /// together (the overlap fades, they never part); the clamped damping
+    /// (`model.damping = "clamped_restitution"`) cannot reach it and refuses it.
     #[serde(default = "default_e_rest")]
     pub restitution: f64,
     /// Coulomb friction coefficient mu, >= 0. Default 0.5.
@@ -101,7 +104,7 @@ impl Material {
         let rho = self.density;
         check(rho.is_finite() && rho > 0.0, at, "density", rho, "> 0 kg/m^3")?;
         let r = self.restitution;
-        check(r > 0.0 && r <= 1.0, at, "restitution", r, "(0, 1]")?;
+        check((0.0..=1.0).contains(&r), at, "restitution", r, "[0, 1] (0: the grains never part, with the default damping)")?;
         let mu = self.friction;
         check(mu.is_finite() && mu >= 0.0, at, "friction", mu, ">= 0")?;
         let w = self.work_of_adhesion;
@@ -117,10 +120,31 @@ impl Material {
     }
 }
 
-/// `beta(e) = ln e / sqrt(ln^2 e + pi^2)`: negative for e < 1, zero for e = 1.
-pub fn beta(restitution: f64) -> f64 {
-    let l = restitution.ln();
-    l / (l * l + std::f64::consts::PI * std::f64::consts::PI).sqrt()
+pub use crate::physics::restitution::beta;
+use crate::physics::restitution::clamped_beta;
+
+/// How a pair's damping `beta` follows from its restitution e.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum BetaRule {
+    /// `beta(e)`, which returns e when the normal force may turn attractive at the end of
+    /// contact (the default damping).
+    #[default]
+    Free,
+    /// The beta that returns e under the clamp `Fn >= 0`, for either normal law
+    /// ([`crate::physics::restitution::clamped_beta`]; `model.damping =
+    /// "clamped_restitution"`).
+    Clamped,
+}
+
+impl BetaRule {
+    /// The pair's beta for restitution `e` (validation has refused e = 0 for the clamped
+    /// rule, which has no finite beta; it falls back to beta(e) there).
+    pub fn beta(self, e: f64) -> f64 {
+        match self {
+            BetaRule::Free => beta(e),
+            BetaRule::Clamped => clamped_beta(e).unwrap_or_else(|| beta(e)),
+        }
+    }
 }
 
 /// The mixed properties of one material pair (`R = Lanes`: of four pairs, one per lane).
@@ -173,12 +197,18 @@ impl PairMaterial {
         self.pulloff / (2.0 * std::f64::consts::PI)
     }
 
+    /// The pair's properties with the default damping's `beta(e)` ([`BetaRule::Free`]).
     pub fn mix(a: &Material, b: &Material) -> Self {
+        Self::mix_with(a, b, BetaRule::Free)
+    }
+
+    /// The pair's properties with the scene's rule for beta (`Scene::model.beta_rule()`).
+    pub fn mix_with(a: &Material, b: &Material, rule: BetaRule) -> Self {
         let (e1, n1, e2, n2) = (a.youngs_modulus, a.poisson_ratio, b.youngs_modulus, b.poisson_ratio);
         let e_star = 1.0 / ((1.0 - n1 * n1) / e1 + (1.0 - n2 * n2) / e2);
         let g_star = 1.0 / (2.0 * (2.0 - n1) * (1.0 + n1) / e1 + 2.0 * (2.0 - n2) * (1.0 + n2) / e2);
         let restitution = a.restitution.min(b.restitution);
-        let beta = beta(restitution);
+        let beta = rule.beta(restitution);
         let c = -2.0 * SQRT_FIVE_SIXTHS * beta;
         let (viscous_n, viscous_t) = (c * (2.0 * e_star).sqrt(), c * (8.0 * g_star).sqrt());
         let pulloff = 2.0 * std::f64::consts::PI * (a.work_of_adhesion * b.work_of_adhesion).sqrt();
@@ -194,12 +224,12 @@ pub struct PairTable {
 }
 
 impl PairTable {
-    pub fn new(materials: &[Material]) -> Self {
+    pub fn new(materials: &[Material], rule: BetaRule) -> Self {
         let n = materials.len();
         let mut pairs = Vec::with_capacity(n * n);
         for a in materials {
             for b in materials {
-                pairs.push(PairMaterial::mix(a, b));
+                pairs.push(PairMaterial::mix_with(a, b, rule));
             }
         }
         PairTable { n, pairs }

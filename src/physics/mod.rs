@@ -10,4 +10,5 @@ pub mod energy;
 pub mod lanes;
 pub mod material;
 pub mod particles;
+pub mod restitution;
 pub mod walls;

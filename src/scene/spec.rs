@@ -411,6 +411,17 @@ pub enum DampingSpec {
     /// sqrt(kn m*)`; tangential alike with St, kt.
     #[default]
     Restitution,
+    /// The restitution damping with the beta that returns each pair's e *under the
+    /// clamp* (`model.limit_force: true`, which it requires): the same force laws as
+    /// `restitution`, with `beta` solved from the clamped contact's equation of motion
+    /// (a closed form, the same for Hertz and the spring: src/physics/restitution.rs,
+    /// docs/model.md) instead of `beta(e)`, which under the clamp returns more than e
+    /// (0.2 gives 0.325). |beta| exceeds 1 below e = exp(-2) = 0.135; e = 0 is refused
+    /// (infinite damping). The
+    /// tangential damping takes the same beta. Exported to YADE (which always clamps)
+    /// and LAMMPS (`limit_damping`) as their damping coefficient; to LIGGGHTS as the
+    /// restitution whose beta(e) it is, where |beta| < 1.
+    ClampedRestitution,
     /// LAMMPS' `damping tsuji` (pair granular and fix wall/gran granular, 29Sep2021):
     /// `gn = alpha(e) sqrt(m* kn)`, `gt = alpha(e) sqrt(m* kt)` (the force -g v), kn the secant normal
     /// stiffness (Hertz 4/3 E* sqrt(R* dn), or the spring's), kt the tangential one, and
@@ -426,6 +437,17 @@ pub enum DampingSpec {
 impl DampingSpec {
     pub fn is_restitution(&self) -> bool {
         *self == DampingSpec::Restitution
+    }
+}
+
+impl ModelSpec {
+    /// How each pair's damping beta follows from its restitution under this model.
+    pub fn beta_rule(&self) -> crate::physics::material::BetaRule {
+        use crate::physics::material::BetaRule;
+        match self.damping {
+            DampingSpec::ClampedRestitution => BetaRule::Clamped,
+            _ => BetaRule::Free,
+        }
     }
 }
 

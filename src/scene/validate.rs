@@ -164,6 +164,14 @@ impl Scene {
             }
         }
         let tsuji = self.model.damping == DampingSpec::Tsuji;
+        // The clamped restitution damping returns e under the clamp, which it needs, and
+        // has no finite damping for e = 0.
+        if self.model.damping == DampingSpec::ClampedRestitution {
+            check(self.model.limit_force, "model", "damping", "\"clamped_restitution\"", "\"restitution\" with model.limit_force = false (the clamped damping returns e only under the clamp Fn >= 0: set limit_force true)")?;
+            if let Some(k) = self.materials.iter().position(|m| m.restitution == 0.0) {
+                check(false, &format!("materials[{k}]"), "restitution", 0.0, "(0, 1] with model.damping = clamped_restitution (under the clamp e -> 0 needs infinite damping; without the clamp, the default damping's e = 0 keeps the grains together)")?;
+            }
+        }
         check(!(tsuji && self.model.tangential == TangentialSpec::IncrementalForce), "model", "damping", "tsuji", &format!("\"restitution\" with model.tangential = incremental_force (compiled: {})", crate::physics::contact::model::COMPILED))?;
         // DMT cohesion is compiled with the restitution damping, frictionless or with the
         // total displacement, and without the clamp (which would remove the attraction).

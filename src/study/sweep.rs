@@ -20,9 +20,10 @@
 //!   extrapolated. A quantity with no rigid limit (an impact's peak force, overlap and
 //!   contact time) has no reference there.
 //!
-//! Where a closed form exists it is reported too: the input restitution (which the
-//! continuous-time law without the clamp returns exactly) and, for an elastic impact of
-//! two equal grains, Hertz's largest overlap, peak force and contact time.
+//! Where a closed form exists it is reported too: the restitution the continuous-time law
+//! returns (the input without the clamp or with the clamped damping; beta(e)'s or Tsuji's
+//! closed form otherwise, docs/model.md) and, for an elastic impact of two equal grains,
+//! Hertz's largest overlap, peak force and contact time.
 //!
 //! **Costs** are the run's own clock of its time stepping (building and packing left
 //! out): the median of `repeats` runs of a deterministic scene, or of the runs of an
@@ -710,8 +711,22 @@ fn closed_form(s: &Scene) -> Option<Closed> {
     let e = PairMaterial::mix(m, m).e_star;
     let (ms, rs) = (mass / 2.0, r / 2.0);
     let d = hertz_max_overlap(ms, rs, e, v);
+    // The restitution the continuous-time law returns (docs/model.md): the input, except
+    // with the clamp (beta(e) then returns more) or Tsuji's fit, both in closed form.
+    use crate::physics::restitution::clamped_restitution;
+    use crate::scene::DampingSpec;
+    let b = match s.model.damping {
+        DampingSpec::Tsuji => crate::physics::contact::damping::tsuji_alpha(m.restitution) / 5f64.sqrt(),
+        _ => s.model.beta_rule().beta(m.restitution).abs(),
+    };
+    let restitution = match (s.model.limit_force, s.model.damping) {
+        (false, DampingSpec::Tsuji) => if b < 1.0 { (-std::f64::consts::PI * b / (1.0 - b * b).sqrt()).exp() } else { 0.0 },
+        (false, _) => m.restitution,
+        (true, DampingSpec::ClampedRestitution) => m.restitution,
+        (true, _) => clamped_restitution(b),
+    };
     Some(Closed {
-        restitution: m.restitution,
+        restitution,
         max_overlap: d,
         peak_force: 4.0 / 3.0 * e * rs.sqrt() * d.powf(1.5),
         contact_time: hertz_contact_time_exact(ms, rs, e, v),
