@@ -457,6 +457,16 @@ fn bases(dir: &Path) -> Vec<Base> {
     let mut damped = json_of(&collision);
     damped["model"]["damping"] = json!("restitution");
     out.push(Base { name: "collision-damping", scene: damped, only: &["model.damping"], variant_of: None });
+    // The same under the clamp, which the clamped damping requires: the walk moves it
+    // there too.
+    let mut clamped = json_of(&collision);
+    clamped["model"]["damping"] = json!("restitution");
+    clamped["model"]["limit_force"] = json!(true);
+    out.push(Base { name: "collision-clamped-damping", scene: clamped, only: &["model.damping"], variant_of: None });
+    // A restitution below LIGGGHTS' floor (0.05 < e), as a change of the collision's.
+    let mut low = collision.clone();
+    low.materials[0].restitution = 0.04;
+    out.push(variant("collision-low-restitution", &low, "collision", "materials[].restitution", &["materials[].restitution"]));
     // The work of adhesion, written out at 0 (written scenes leave it out): the walk
     // moves it above 0, DMT cohesion (LAMMPS alone, Hertz only), on the Hertz pair and
     // under the given spring.

@@ -176,7 +176,8 @@ pub const FIELDS: &[Field] = &[
     ),
     each(
         "materials[].restitution",
-        written("`fix m3 ... coefficientRestitution peratomtypepair`, each pair the smaller e (grainlab's rule)"),
+        written("`fix m3 ... coefficientRestitution peratomtypepair`, each pair the smaller e (grainlab's rule)")
+            .or_refused("e <= 0.05: LIGGGHTS 3.8 requires 0.05 < coefficientRestitution <= 1 (global_properties.cpp)"),
         written("BETA = sqrt(5/6) |beta(e)| as Ip2_FrictMat_FrictMat_MindlinPhys(betan = betas = BETA), never `en` (a different damping fit)")
             .or_refused("materials of different restitution: YADE's Ip2_FrictMat_FrictMat_MindlinPhys takes one betan for every pair"),
     )
@@ -315,10 +316,12 @@ pub const FIELDS: &[Field] = &[
     .in_lammps(written(SPRING_M)),
     each(
         "model.damping",
-        refused("\"tsuji\": LIGGGHTS 3.8's `model hertz` and `model hooke` damp with beta(e) only; it has no Tsuji fit"),
-        refused("\"tsuji\": YADE's Mindlin law damps with betan, betas only; it has no Tsuji fit"),
+        written("\"clamped_restitution\": coefficientRestitution of each pair the e' whose beta(e') is the pair's clamped beta (LIGGGHTS turns it back to rounding)")
+            .or_refused("\"tsuji\": LIGGGHTS 3.8's `model hertz` and `model hooke` damp with beta(e) only; it has no Tsuji fit; \"clamped_restitution\" with a pair's e below 0.214, whose e' is at or below 0.05 (LIGGGHTS requires 0.05 < coefficientRestitution)"),
+        written("\"clamped_restitution\": betan = betas = sqrt(5/6) |beta| of the clamped beta (Hertz), the spring's cn, cs from it (YADE always clamps)")
+            .or_refused("\"tsuji\": YADE's Mindlin law damps with betan, betas only; it has no Tsuji fit"),
     )
-    .in_lammps(written("\"restitution\": `damping tsuji` with the input that gives grainlab's damping (materials[].restitution); \"tsuji\": `damping tsuji` with each pair's restitution as its input, LAMMPS' own fit, and X = sqrt(kt / kn)")),
+    .in_lammps(written("\"restitution\" and \"clamped_restitution\": `damping tsuji` with the input that gives grainlab's damping of each pair (materials[].restitution and its beta); \"tsuji\": `damping tsuji` with each pair's restitution as its input, LAMMPS' own fit, and X = sqrt(kt / kn)")),
     each(
         "model.tangential",
         written("total_displacement: `pair_style gran model hertz tangential history`; frictionless: coefficientFriction 0 (Ft = 0) and `nve`")

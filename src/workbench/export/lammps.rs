@@ -38,11 +38,15 @@ use crate::scene::{DampingSpec, NormalLaw, Scene, TangentialSpec};
 pub use crate::physics::contact::damping::tsuji_alpha;
 
 /// The input c for which LAMMPS' Tsuji polynomial gives `alpha` (> 0). The polynomial
-/// falls monotonically on [-1, 1.1] from 89.1 to -0.05 (tested), so every alpha of a
-/// restitution in (0, 1) has one root there, found by bisection to the last bit. LAMMPS
+/// falls monotonically on [-1, 1.1] from 89.1 to -0.05 (tested), and below -1 too (every
+/// term then grows as c falls), so every alpha has one root, found by bisection to the
+/// last bit (the bracket widened below -1 for the clamped damping's large alphas). LAMMPS
 /// does not clip c to [0, 1]: e below about 0.11 needs c < 0, e above 0.9995 c > 1.
 pub fn tsuji_input(alpha: f64) -> f64 {
     let (mut lo, mut hi) = (-1.0_f64, 1.1_f64);
+    while tsuji_alpha(lo) <= alpha && lo > -1e6 {
+        (hi, lo) = (lo, 2.0 * lo);
+    }
     for _ in 0..200 {
         let mid = 0.5 * (lo + hi);
         if mid <= lo || mid >= hi {
@@ -129,7 +133,7 @@ pub(crate) fn pair_style(w: &mut String, scene: &Scene, kinds: &ContactKinds) ->
     let _ = writeln!(w, "pair_style granular");
     for a in 0..n {
         for b in a..n {
-            let pm = PairMaterial::mix(&mats[a], &mats[b]);
+            let pm = PairMaterial::mix_with(&mats[a], &mats[b], scene.model.beta_rule());
             let model = words(scene, &pm, &kinds.pairs[a * n + b], &format!("materials[{a}] and materials[{b}]"))?;
             let _ = writeln!(w, "pair_coeff {} {} {model}", a + 1, b + 1);
         }
@@ -145,7 +149,7 @@ pub(crate) fn flat_wall(w: &mut String, scene: &Scene, ex: &Exported, kinds: &Co
     let mats = &scene.materials;
     let present: Vec<usize> = (0..mats.len()).filter(|&a| !kinds.walls[index][a].is_empty()).collect();
     for &a in &present {
-        let pm = PairMaterial::mix(&mats[wall.material], &mats[a]);
+        let pm = PairMaterial::mix_with(&mats[wall.material], &mats[a], scene.model.beta_rule());
         let model = words(scene, &pm, &kinds.walls[index][a], &format!("walls.{} and the free grains of materials[{a}]", wall.name))?;
         let group = if present.len() == 1 {
             "free".to_string()

@@ -22,7 +22,8 @@ use super::common::{Code, escaped, f};
 use super::prepare::Exported;
 use crate::error::Error;
 use crate::physics::contact::LeverArm;
-use crate::physics::material::PairMaterial;
+use crate::physics::material::{BetaRule, PairMaterial};
+use crate::physics::restitution::restitution_of_beta;
 use crate::engine::world::WallMotion;
 use crate::physics::walls::{Control, Surface};
 use crate::scene::{Analysis, NormalLaw, Scene, TangentialSpec};
@@ -186,8 +187,28 @@ fn materials(w: &mut String, scene: &Scene, ex: &Exported) -> Result<String, Err
     let _ = writeln!(w, "fix m2 all property/global poissonsRatio peratomtype {}", list(&|m| m.poisson_ratio));
     // A `peratomtypepair` table: g of each pair of atom types (materials), row by row.
     let table = |g: &dyn Fn(usize, usize) -> f64| (0..n).flat_map(|a| (0..n).map(move |b| (a, b))).map(|(a, b)| f(g(a, b))).collect::<Vec<_>>().join(" ");
-    let pair = |g: &dyn Fn(&PairMaterial) -> f64| table(&|a, b| g(&PairMaterial::mix(&mats[a], &mats[b])));
-    let _ = writeln!(w, "fix m3 all property/global coefficientRestitution peratomtypepair {n} {}", pair(&|pm| pm.restitution));
+    let rule = model.beta_rule();
+    let pair = |g: &dyn Fn(&PairMaterial) -> f64| table(&|a, b| g(&PairMaterial::mix_with(&mats[a], &mats[b], rule)));
+    // The clamped damping: the restitution whose beta(e) LIGGGHTS turns back into the
+    // pair's clamped beta (to rounding); none exists for |beta| >= 1 (e below exp(-2)).
+    // LIGGGHTS 3.8 takes 0.05 < coefficientRestitution <= 1 only (global_properties.cpp).
+    let restitution = |pm: &PairMaterial| if rule == BetaRule::Free { Some(pm.restitution) } else { restitution_of_beta(pm.beta) };
+    for a in 0..n {
+        for b in a..n {
+            let pm = PairMaterial::mix_with(&mats[a], &mats[b], rule);
+            match restitution(&pm) {
+                Some(e) if e > 0.05 => {}
+                _ if rule == BetaRule::Free => {
+                    let k = if mats[a].restitution <= mats[b].restitution { a } else { b };
+                    return Err(refuse(Code::Liggghts, &format!("materials[{k}].restitution"), mats[k].restitution, "0.05 < e: LIGGGHTS 3.8 requires 0.05 < coefficientRestitution <= 1"));
+                }
+                e => {
+                    return Err(refuse(Code::Liggghts, "model.damping", "\"clamped_restitution\"", &format!("materials[{a}] and materials[{b}] (e = {}): the clamped beta {} needs a coefficientRestitution of {}, and LIGGGHTS 3.8 requires 0.05 < coefficientRestitution <= 1 (pairs of e above 0.214 can be written)", pm.restitution, pm.beta, e.map_or("none (|beta| >= 1)".to_string(), |e| format!("{e:e}")))));
+                }
+            }
+        }
+    }
+    let _ = writeln!(w, "fix m3 all property/global coefficientRestitution peratomtypepair {n} {}", pair(&|pm| restitution(pm).unwrap_or(pm.restitution)));
     let frictionless = model.tangential == TangentialSpec::Frictionless;
     let _ = writeln!(w, "fix m4 all property/global coefficientFriction peratomtypepair {n} {}", pair(&|pm| if frictionless { 0.0 } else { pm.friction }));
     let style = match model.normal {
@@ -392,7 +413,7 @@ fn spring_rates(scene: &Scene, p: &crate::physics::particles::Particles, walls: 
                 ));
             }
             if let Some(&m) = m.first() {
-                let beta = PairMaterial::mix(&scene.materials[a], &scene.materials[b]).beta;
+                let beta = PairMaterial::mix_with(&scene.materials[a], &scene.materials[b], scene.model.beta_rule()).beta;
                 out[a * n + b] = (-2.0 * beta * (kn / m).sqrt(), -2.0 * beta * (kt / m).sqrt());
             }
         }

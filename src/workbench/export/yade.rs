@@ -39,7 +39,9 @@ pub(crate) fn deck(scene: &Scene, ex: &Exported) -> Result<String, Error> {
     {
         return Err(refuse(Code::Yade, &format!("materials[{k}].restitution"), mats[k].restitution, &format!("materials[0].restitution = {}", mats[0].restitution)));
     }
-    let pairs: Vec<PairMaterial> = mats.iter().flat_map(|a| mats.iter().map(move |b| PairMaterial::mix(a, b))).collect();
+    // The clamped damping's beta is YADE's own case: it always clamps.
+    let rule = model.beta_rule();
+    let pairs: Vec<PairMaterial> = mats.iter().flat_map(|a| mats.iter().map(move |b| PairMaterial::mix_with(a, b, rule))).collect();
     let e = ex.built.engine.as_ref();
     let info = &ex.info;
     let p = e.particles();
@@ -103,7 +105,8 @@ pub(crate) fn deck(scene: &Scene, ex: &Exported) -> Result<String, Error> {
         }
         let _ = writeln!(w, "WALL_MAT = [{}]  # each wall's material (its friction)", walls.iter().map(|wl| wl.material.to_string()).collect::<Vec<_>>().join(", "));
     } else {
-        let _ = writeln!(w, "BETA = {}  # sqrt(5/6) |ln e| / sqrt(ln^2 e + pi^2)", f(beta));
+        let how = if rule == crate::physics::material::BetaRule::Free { "sqrt(5/6) |ln e| / sqrt(ln^2 e + pi^2)" } else { "sqrt(5/6) |beta| of the beta that returns e under the clamp (model.damping clamped_restitution)" };
+        let _ = writeln!(w, "BETA = {}  # {how}", f(beta));
     }
     let _ = writeln!(w, "DT = {}\nSTEPS = {}", f(info.time_step_s), info.steps);
     let record = !ex.bench && info.analysis != Analysis::None;
@@ -419,7 +422,7 @@ fn spring_materials(scene: &Scene, ex: &Exported) -> Result<SpringMaterials, Err
     for (q, what) in SPRING_QUANTITIES.iter().enumerate() {
         // grainlab's value of a contact of materials a and b at (m*, R*).
         let value = |a: usize, b: usize, m: f64, r: f64| {
-            let pm = PairMaterial::mix(&mats[a], &mats[b]);
+            let pm = PairMaterial::mix_with(&mats[a], &mats[b], scene.model.beta_rule());
             let st = law.stiffness(&pm, r, m, 0.0);
             let (gn, gt) = LinearRestitution::coefficients(&pm, m.sqrt(), &st);
             [st.kn, st.kt, gn.abs(), gt.abs()][q]

@@ -1,0 +1,72 @@
+# YADE 2023.02a script exported by grainlab 0.1.0 from scene `clamped-spring-e0.8`. Generated: do not edit;
+# regenerate with `grainlab export yade SCENE --out DIR`.
+# Run in this directory: yade -n -x yade.py (reads grains.data, writes series.txt).
+# Recorded between the contact law and the integrator: positions x(n), force F(x(n)), velocities v(n-1/2).
+# Differs: model.tangential = total_displacement: YADE's Mindlin law adds force increments; head-on impacts agree, oblique ones differ (rebound spin up to 2x)
+# Differs: model.lever_arm = radius: YADE's Mindlin law (Hertz) has the ScGeom kinematics of lever_arm yade (full radii for the spins in the contact velocity, its translational part scaled by (r1 + r2) / (r1 + r2 - dn), torque arm r - dn/2, r - dn on a wall); its ViscElPhys law (the linear spring) the contact point's, lever_arm contact_point (r - dn/2 between grains, r - dn on a wall, in the velocity and the torque); torques and tangential velocities differ by O(dn/r)
+import math, sys
+RHO = [2.50000000000000000e3]
+MU = [5.00000000000000000e-1]
+# The linear spring: each material's (and flat wall's) kn, ks (N/m), cn, cs (kg/s), which YADE puts in series per
+# contact (k1 k2 / (k1 + k2); 0: the other's), solved by grainlab from its pairs' kn, kt, 2 |beta| sqrt(m* k).
+KN = [4.00000000000000000e5]
+KS = [3.00000000000000000e5]
+CN = [3.04358226927880171e-1]
+CS = [2.63581956370333270e-1]
+WALL_KN = []
+WALL_KS = []
+WALL_CN = []
+WALL_CS = []
+WALL_MAT = []  # each wall's material (its friction)
+DT = 3.21487566790691598e-8
+STEPS = 15210
+RECORD = True  # False in a timing deck
+mats = [O.materials.append(ViscElMat(kn=KN[k], ks=KS[k], cn=CN[k], cs=CS[k], density=RHO[k], frictionAngle=math.atan(MU[k]))) for k in range(len(RHO))]
+wmats = [O.materials.append(ViscElMat(kn=WALL_KN[j], ks=WALL_KS[j], cn=WALL_CN[j], cs=WALL_CS[j], density=1.0, frictionAngle=math.atan(MU[WALL_MAT[j]]))) for j in range(len(WALL_KN))]
+def grains():
+    """The spheres of grains.data, in order, not yet added to the scene."""
+    with open('grains.data') as fh:
+        lines = [l.split() for l in fh.read().splitlines()]
+    atoms = lines.index(['Atoms']) + 2
+    vels = lines.index(['Velocities']) + 2
+    out = []
+    for k in range(int(lines[2][0])):
+        i, t, d, rho, x, y, z = lines[atoms + k]
+        b = sphere((float(x), float(y), float(z)), 0.5 * float(d), material=mats[int(t) - 1])
+        b.state.blockedDOFs = 'zXY'
+        _, vx, vy, vz, wx, wy, wz = lines[vels + k]
+        b.state.vel = Vector3(float(vx), float(vy), 0.0)
+        b.state.angVel = Vector3(0.0, 0.0, float(wz))
+        out.append(b)
+    return out
+O.engines = [
+    ForceResetter(),
+    InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Wall_Aabb()]),
+    InteractionLoop(
+        [Ig2_Sphere_Sphere_ScGeom(), Ig2_Wall_Sphere_ScGeom(hertzian=True)],
+        [Ip2_ViscElMat_ViscElMat_ViscElPhys()],
+        [Law2_ScGeom_ViscElPhys_Basic()],
+    ),
+] + ([PyRunner(iterPeriod=1, command='record()')] if RECORD else []) + [
+    NewtonIntegrator(damping=0.0),
+]
+O.dt = DT
+ids = [O.bodies.append(b) for b in grains()]
+out = open('series.txt', 'w')
+cols = ['step']
+for k in range(len(ids)):
+    cols += ['%s%d' % (q, k) for q in ('x_m', 'y_m', 'vx_m_s', 'vy_m_s', 'omega_rad_s', 'fx_n', 'fy_n')]
+out.write(' '.join(cols) + '\n')
+def record():
+    row = ['%d' % O.iter]
+    for i in ids:
+        st = O.bodies[i].state
+        fo = O.forces.f(i, sync=True)
+        row += ['%.17g' % v for v in (st.pos[0], st.pos[1], st.vel[0], st.vel[1], st.angVel[2], fo[0], fo[1])]
+    out.write(' '.join(row) + '\n')
+import time
+t0 = time.time()
+O.run(STEPS, True)
+print('grainlab-loop-seconds %.6f' % (time.time() - t0))
+out.close()
+sys.exit(0)
