@@ -420,7 +420,8 @@ pub enum DampingSpec {
     /// (infinite damping). The
     /// tangential damping takes the same beta. Exported to YADE (which always clamps)
     /// and LAMMPS (`limit_damping`) as their damping coefficient; to LIGGGHTS as the
-    /// restitution whose beta(e) it is, where |beta| < 1.
+    /// restitution whose beta(e) it is (Hertz: e above 0.214, where that restitution is
+    /// above the 0.05 LIGGGHTS takes; refused below).
     ClampedRestitution,
     /// LAMMPS' `damping tsuji` (pair granular and fix wall/gran granular, 29Sep2021):
     /// `gn = alpha(e) sqrt(m* kn)`, `gt = alpha(e) sqrt(m* kt)` (the force -g v), kn the secant normal

@@ -188,8 +188,8 @@ fn lammps_cases(out: &mut Vec<Case>) {
 
 /// The damping that returns e under the clamp (`model.damping = "clamped_restitution"`,
 /// `limit_force`): head-on impacts under Hertz (e = 0.05, 0.2, 0.5, 0.8) and the given
-/// spring (e = 0.2, 0.8) at 1 m/s, t_c/500, against all three codes (LIGGGHTS where its
-/// restitution, above 0.05, can carry the clamped beta: e above 0.214). `clamped/...`.
+/// spring (e = 0.2, 0.8) at 1 m/s, t_c/500, against all three codes (LIGGGHTS' Hertz where
+/// its restitution, above 0.05, can carry the clamped beta: e above 0.214). `clamped/...`.
 fn clamped_damping_cases(out: &mut Vec<Case>) {
     use crate::scene::{DampingSpec, NormalLaw};
     for (tag, law, es) in [("hertz", NormalLaw::Hertz, &[0.05, 0.2, 0.5, 0.8][..]), ("spring", NormalLaw::HookeStiffness { kn: SPRING_KN, kt: SPRING_KT }, &[0.2, 0.8][..])] {
@@ -198,8 +198,9 @@ fn clamped_damping_cases(out: &mut Vec<Case>) {
             s.model.damping = DampingSpec::ClampedRestitution;
             s.model.limit_force = true;
             s.duration *= 10.0;
-            // LIGGGHTS takes a coefficientRestitution above 0.05 only: e above 0.214 here.
-            let written = crate::physics::restitution::clamped_beta(e).and_then(crate::physics::restitution::restitution_of_beta).is_some_and(|e| e > 0.05);
+            // LIGGGHTS' Hertz takes a coefficientRestitution above 0.05 only: e above 0.214
+            // here (its hooke/stiffness damps with the written gammas, any e).
+            let written = tag == "spring" || crate::physics::restitution::clamped_beta(e).and_then(crate::physics::restitution::restitution_of_beta).is_some_and(|e| e > 0.05);
             let codes = if written { vec![Code::Liggghts, Code::Yade, Code::Lammps] } else { vec![Code::Yade, Code::Lammps] };
             s.description = format!("head-on glass beads r = 1 mm, {tag}, the clamped damping returning e = {e} under the clamp, v = 1 m/s, dt = t_c/500");
             out.push(Case::new(format!("clamped/{tag}-e{}", num(e)), s, codes, e == 0.2));

@@ -177,7 +177,7 @@ pub const FIELDS: &[Field] = &[
     each(
         "materials[].restitution",
         written("`fix m3 ... coefficientRestitution peratomtypepair`, each pair the smaller e (grainlab's rule)")
-            .or_refused("e <= 0.05: LIGGGHTS 3.8 requires 0.05 < coefficientRestitution <= 1 (global_properties.cpp)"),
+            .or_refused("e <= 0.05 under `model hertz` and `model hooke`: LIGGGHTS 3.8 requires 0.05 < coefficientRestitution <= 1 (global_properties.cpp; `hooke/stiffness` damps with the written gammas and takes any)"),
         written("BETA = sqrt(5/6) |beta(e)| as Ip2_FrictMat_FrictMat_MindlinPhys(betan = betas = BETA), never `en` (a different damping fit)")
             .or_refused("materials of different restitution: YADE's Ip2_FrictMat_FrictMat_MindlinPhys takes one betan for every pair"),
     )
@@ -317,7 +317,7 @@ pub const FIELDS: &[Field] = &[
     each(
         "model.damping",
         written("\"clamped_restitution\": coefficientRestitution of each pair the e' whose beta(e') is the pair's clamped beta (LIGGGHTS turns it back to rounding)")
-            .or_refused("\"tsuji\": LIGGGHTS 3.8's `model hertz` and `model hooke` damp with beta(e) only; it has no Tsuji fit; \"clamped_restitution\" with a pair's e below 0.214, whose e' is at or below 0.05 (LIGGGHTS requires 0.05 < coefficientRestitution)"),
+            .or_refused("\"tsuji\": LIGGGHTS 3.8's `model hertz` and `model hooke` damp with beta(e) only; it has no Tsuji fit; \"clamped_restitution\" under `model hertz` or `model hooke` with a pair's e below 0.214, whose e' is at or below 0.05 (LIGGGHTS requires 0.05 < coefficientRestitution there)"),
         written("\"clamped_restitution\": betan = betas = sqrt(5/6) |beta| of the clamped beta (Hertz), the spring's cn, cs from it (YADE always clamps)")
             .or_refused("\"tsuji\": YADE's Mindlin law damps with betan, betas only; it has no Tsuji fit"),
     )

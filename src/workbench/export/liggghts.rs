@@ -191,13 +191,17 @@ fn materials(w: &mut String, scene: &Scene, ex: &Exported) -> Result<String, Err
     let pair = |g: &dyn Fn(&PairMaterial) -> f64| table(&|a, b| g(&PairMaterial::mix_with(&mats[a], &mats[b], rule)));
     // The clamped damping: the restitution whose beta(e) LIGGGHTS turns back into the
     // pair's clamped beta (to rounding); none exists for |beta| >= 1 (e below exp(-2)).
-    // LIGGGHTS 3.8 takes 0.05 < coefficientRestitution <= 1 only (global_properties.cpp).
+    // LIGGGHTS 3.8 takes 0.05 < coefficientRestitution <= 1 only (global_properties.cpp),
+    // where its law reads it: `model hertz` and `model hooke`; `model hooke/stiffness`
+    // damps with the gammas written below and ran with 0.0345 (the clamped/spring-e0.2 case).
     let restitution = |pm: &PairMaterial| if rule == BetaRule::Free { Some(pm.restitution) } else { restitution_of_beta(pm.beta) };
+    let reads_restitution = !matches!(model.normal, NormalLaw::HookeStiffness { .. });
     for a in 0..n {
         for b in a..n {
             let pm = PairMaterial::mix_with(&mats[a], &mats[b], rule);
             match restitution(&pm) {
                 Some(e) if e > 0.05 => {}
+                _ if !reads_restitution => {}
                 _ if rule == BetaRule::Free => {
                     let k = if mats[a].restitution <= mats[b].restitution { a } else { b };
                     return Err(refuse(Code::Liggghts, &format!("materials[{k}].restitution"), mats[k].restitution, "0.05 < e: LIGGGHTS 3.8 requires 0.05 < coefficientRestitution <= 1"));
