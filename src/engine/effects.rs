@@ -78,7 +78,8 @@ impl Effects {
     pub fn of(scene: &Scene, p: &Particles, walls: &[Wall]) -> Effects {
         let mats = &scene.materials;
         let pairs = meeting_pairs(p, walls);
-        let mix = |&(a, b): &(usize, usize)| PairMaterial::mix(&mats[a], &mats[b]);
+        let rule = scene.model.beta_rule();
+        let mix = |&(a, b): &(usize, usize)| PairMaterial::mix_with(&mats[a], &mats[b], rule);
         let mut list = Vec::new();
         let mut push = |name: &str, on: bool, why: String, measured_as: Option<&'static str>| list.push(Effect { name: name.into(), on, why, measured_as });
 
@@ -125,7 +126,7 @@ impl Effects {
         let damping_why = match lossy {
             _ if tsuji => "declared: model.damping = tsuji (LAMMPS' fit alpha(e) sqrt(m* k); alpha(1) = 3e-4 damps e = 1 too, and the realised e is not the input e)".to_string(),
             Some(&q) if scene.model.damping == crate::scene::DampingSpec::ClampedRestitution => {
-                let pm = PairMaterial::mix_with(&mats[q.0], &mats[q.1], scene.model.beta_rule());
+                let pm = mix(&q);
                 format!("derived: the {} pair has restitution {} < 1 (declared model.damping = clamped_restitution: beta = {:.6} returns it under the clamp, against beta(e) = {:.6})", pair_name(mats, q), pm.restitution, pm.beta, crate::physics::material::beta(pm.restitution))
             }
             Some(&q) => format!("derived: the {} pair has restitution {} < 1", pair_name(mats, q), mix(&q).restitution),

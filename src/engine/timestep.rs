@@ -87,17 +87,12 @@ fn verlet_limit(omega: f64, zeta: f64) -> f64 {
 /// stiffnesses are `kn` (secant) and `sn` (tangent).
 fn damping_ratios(model: &ModelSpec, c: &RefContact, kn: f64, sn: f64) -> (f64, f64) {
     let tangential_mass = (c.m_star * c.inv_tangential_mass).sqrt();
-    let hertz = model.normal == NormalLaw::Hertz;
-    let zeta_n = match model.damping {
-        DampingSpec::Tsuji => 0.5 * crate::physics::contact::damping::tsuji_alpha(c.pair.restitution) * (kn / sn).sqrt(),
-        _ if hertz => crate::physics::material::SQRT_FIVE_SIXTHS * c.pair.beta.abs(),
-        _ => c.pair.beta.abs(),
-    };
-    let zeta_t = match model.damping {
-        DampingSpec::Tsuji => 0.5 * crate::physics::contact::damping::tsuji_alpha(c.pair.restitution) * tangential_mass,
-        _ => zeta_n * tangential_mass,
-    };
-    (zeta_n, zeta_t)
+    if model.damping == DampingSpec::Tsuji {
+        let half_alpha = 0.5 * crate::physics::contact::damping::tsuji_alpha(c.pair.restitution);
+        return (half_alpha * (kn / sn).sqrt(), half_alpha * tangential_mass);
+    }
+    let zeta_n = if model.normal == NormalLaw::Hertz { crate::physics::material::SQRT_FIVE_SIXTHS * c.pair.beta.abs() } else { c.pair.beta.abs() };
+    (zeta_n, zeta_n * tangential_mass)
 }
 
 /// Contact time, stability limit over the reference contacts at speed `v` under the

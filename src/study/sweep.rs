@@ -713,14 +713,15 @@ fn closed_form(s: &Scene) -> Option<Closed> {
     let d = hertz_max_overlap(ms, rs, e, v);
     // The restitution the continuous-time law returns (docs/model.md): the input, except
     // with the clamp (beta(e) then returns more) or Tsuji's fit, both in closed form.
-    use crate::physics::restitution::clamped_restitution;
+    use crate::physics::restitution::{clamped_restitution, restitution_of_beta};
     use crate::scene::DampingSpec;
     let b = match s.model.damping {
         DampingSpec::Tsuji => crate::physics::contact::damping::tsuji_alpha(m.restitution) / 5f64.sqrt(),
         _ => s.model.beta_rule().beta(m.restitution).abs(),
     };
     let restitution = match (s.model.limit_force, s.model.damping) {
-        (false, DampingSpec::Tsuji) => if b < 1.0 { (-std::f64::consts::PI * b / (1.0 - b * b).sqrt()).exp() } else { 0.0 },
+        // exp(-pi b / sqrt(1 - b^2)); b >= 1 never parts.
+        (false, DampingSpec::Tsuji) => restitution_of_beta(-b).unwrap_or(0.0),
         (false, _) => m.restitution,
         (true, DampingSpec::ClampedRestitution) => m.restitution,
         (true, _) => clamped_restitution(b),

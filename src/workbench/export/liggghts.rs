@@ -188,7 +188,9 @@ fn materials(w: &mut String, scene: &Scene, ex: &Exported) -> Result<String, Err
     // A `peratomtypepair` table: g of each pair of atom types (materials), row by row.
     let table = |g: &dyn Fn(usize, usize) -> f64| (0..n).flat_map(|a| (0..n).map(move |b| (a, b))).map(|(a, b)| f(g(a, b))).collect::<Vec<_>>().join(" ");
     let rule = model.beta_rule();
-    let pair = |g: &dyn Fn(&PairMaterial) -> f64| table(&|a, b| g(&PairMaterial::mix_with(&mats[a], &mats[b], rule)));
+    // Each pair of materials mixed once, row by row.
+    let pms: Vec<PairMaterial> = (0..n * n).map(|k| PairMaterial::mix_with(&mats[k / n], &mats[k % n], rule)).collect();
+    let pair = |g: &dyn Fn(&PairMaterial) -> f64| table(&|a, b| g(&pms[a * n + b]));
     // The clamped damping: the restitution whose beta(e) LIGGGHTS turns back into the
     // pair's clamped beta (to rounding); none exists for |beta| >= 1 (e below exp(-2)).
     // LIGGGHTS 3.8 takes 0.05 < coefficientRestitution <= 1 only (global_properties.cpp),
@@ -198,8 +200,8 @@ fn materials(w: &mut String, scene: &Scene, ex: &Exported) -> Result<String, Err
     let reads_restitution = !matches!(model.normal, NormalLaw::HookeStiffness { .. });
     for a in 0..n {
         for b in a..n {
-            let pm = PairMaterial::mix_with(&mats[a], &mats[b], rule);
-            match restitution(&pm) {
+            let pm = &pms[a * n + b];
+            match restitution(pm) {
                 Some(e) if e > 0.05 => {}
                 _ if !reads_restitution => {}
                 _ if rule == BetaRule::Free => {
