@@ -9,7 +9,8 @@
 //!    materials and their mixing ([`physics::material`]), the contact law composed at
 //!    compile time ([`physics::contact`]: a normal law, Hertz or the linear spring; a
 //!    damping form, the one that returns e or LAMMPS' Tsuji fit; a tangential
-//!    formulation, LIGGGHTS' total displacement or YADE's increments; one monomorphized
+//!    formulation, LIGGGHTS' total displacement, YADE's increments, LAMMPS' cap on the
+//!    total force or that cap with the spring kept (Kratos' rule); one monomorphized
 //!    kernel per named combination), written once over its number type to run one
 //!    contact or four in SIMD lanes with the same bits ([`physics::lanes`]); walls, flat
 //!    or rough, fixed or loaded ([`physics::walls`]), the periodic boundary in x

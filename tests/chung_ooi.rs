@@ -104,9 +104,9 @@ impl Drop for Rows {
     }
 }
 
-/// The three frictional formulations: LIGGGHTS', YADE's and LAMMPS' (the cap on the total
-/// tangential force, issue 32).
-const FORMS: [TangentialSpec; 3] = [TangentialSpec::TotalDisplacement, TangentialSpec::IncrementalForce, TangentialSpec::TotalForceCap];
+/// The four frictional formulations: LIGGGHTS', YADE's, LAMMPS' (the cap on the total
+/// tangential force, issue 32) and the cap on the total with the spring kept (Kratos' rule).
+const FORMS: [TangentialSpec; 4] = [TangentialSpec::TotalDisplacement, TangentialSpec::IncrementalForce, TangentialSpec::TotalForceCap, TangentialSpec::TotalForceCapSpringKept];
 
 fn form_name(form: TangentialSpec) -> &'static str {
     form.name()
@@ -345,7 +345,14 @@ fn test_6_varying_initial_spin() {
                 // (r dw = kappa dvt) to rounding.
                 let (dvt, dw_r, closed, _) = gross_sliding(&s, &imp, kappa, 0.4);
                 let excess = dvt / closed - 1.0;
-                if form == TangentialSpec::TotalForceCap {
+                if form == TangentialSpec::TotalForceCapSpringKept {
+                    // The cap on the total with the spring kept: the total tangential
+                    // force is mu |Fn| at every sliding step and the contact slides from
+                    // the first (the dashpot alone exceeds the cap there), so the
+                    // identities hold to rounding under damped Hertz (measured: 2.2e-16
+                    // sphere, 1.6e-15 disk).
+                    assert_gross_sliding(&s, &imp, kappa, 0.4, &what);
+                } else if form == TangentialSpec::TotalForceCap {
                     // LAMMPS' law caps the total, so the impulse never exceeds mu J (the
                     // clamp holds Fn >= 0); but it keeps the dashpot's force in the spring
                     // on slip, and Hertz's kt (and gt, as sqrt(kt)) grow while loading: the
@@ -420,7 +427,12 @@ fn test_8_a_small_sphere_on_a_larger_denser_one() {
                 // (measured 7.4% total displacement, 13% incremental force): asserted
                 // within 0 to 15%, and the spin following the tangential impulse.
                 let excess = dvt / (-slip * 0.4 * dvn) - 1.0;
-                if form == TangentialSpec::TotalForceCap {
+                if form == TangentialSpec::TotalForceCapSpringKept {
+                    // The cap on the total with the spring kept: mu J to the turning of
+                    // the line of centres (measured -2.5e-4 sphere, -4.6e-5 disk), as the
+                    // undamped contact below.
+                    assert!(excess.abs() < 1e-3, "{what}: friction impulse {excess:e} from mu J");
+                } else if form == TangentialSpec::TotalForceCap {
                     // LAMMPS' law: at most mu J (within the 1e-3 of the turning line of
                     // centres), short of it as in test 6 (measured 9.2%).
                     assert!((-0.2..1e-3).contains(&excess), "{what}: friction impulse {excess:e} from mu J");

@@ -162,7 +162,7 @@ proptest! {
     #[test]
     fn four_lanes_give_each_contact_its_own_bits(c0 in contact(), c1 in contact(), c2 in contact(), c3 in contact(), clamp in any::<bool>(), lever in 0usize..5) {
         use grainlab::physics::contact::LeverArm;
-        use grainlab::physics::contact::tangential::{IncrementalForce, IncrementalState, TotalDisplacement, TotalForceCap};
+        use grainlab::physics::contact::tangential::{IncrementalForce, IncrementalState, TotalDisplacement, TotalForceCap, TotalForceCapSpringKept};
         use grainlab::physics::contact::damping::{LinearRestitution, TsujiFit, Viscoelastic};
         use grainlab::physics::contact::normal::{Hertz, Hooke};
         use grainlab::physics::contact::rolling::{Cdt, Epsd2, RollingMemory, Sds};
@@ -177,12 +177,16 @@ proptest! {
         // lane), sticking and sliding, with the restitution damping and Tsuji's.
         lanes_match_alone::<Hertz, Viscoelastic, TotalForceCap, NoRolling>(Hertz, NoRolling, &cs, clamp, lever, |c| Vec2::new(c[5], c[6]), v, |_| (), |_| vec![], |_| (), |_| vec![])?;
         lanes_match_alone::<Hertz, TsujiFit, TotalForceCap, NoRolling>(Hertz, NoRolling, &cs, clamp, lever, |c| Vec2::new(c[5], c[6]), v, |_| (), |_| vec![], |_| (), |_| vec![])?;
+        // The cap on the total with the spring kept: sticking, sliding with the spring
+        // below the cap (the dashpot takes the rest) and above it, lane by lane.
+        lanes_match_alone::<Hertz, Viscoelastic, TotalForceCapSpringKept, NoRolling>(Hertz, NoRolling, &cs, clamp, lever, |c| Vec2::new(c[5], c[6]), v, |_| (), |_| vec![], |_| (), |_| vec![])?;
         // The linear spring, derived per pair (a fifth root lane by lane) and given.
         for spring in [Hooke::Derived { vc: 0.8 }, Hooke::Given { kn: 3e5, kt: 2e5 }] {
             lanes_match_alone::<Hooke, LinearRestitution, TotalDisplacement, NoRolling>(spring, NoRolling, &cs, clamp, lever, |c| Vec2::new(c[5], c[6]), v, |_| (), |_| vec![], |_| (), |_| vec![])?;
             lanes_match_alone::<Hooke, LinearRestitution, IncrementalForce, NoRolling>(spring, NoRolling, &cs, clamp, lever, incremental, incremental_bits, |_| (), |_| vec![], |_| (), |_| vec![])?;
             lanes_match_alone::<Hooke, TsujiFit, TotalDisplacement, NoRolling>(spring, NoRolling, &cs, clamp, lever, |c| Vec2::new(c[5], c[6]), v, |_| (), |_| vec![], |_| (), |_| vec![])?;
             lanes_match_alone::<Hooke, LinearRestitution, TotalForceCap, NoRolling>(spring, NoRolling, &cs, clamp, lever, |c| Vec2::new(c[5], c[6]), v, |_| (), |_| vec![], |_| (), |_| vec![])?;
+            lanes_match_alone::<Hooke, LinearRestitution, TotalForceCapSpringKept, NoRolling>(spring, NoRolling, &cs, clamp, lever, |c| Vec2::new(c[5], c[6]), v, |_| (), |_| vec![], |_| (), |_| vec![])?;
         }
         // Rolling resistance: the constant torque (a sign lane by lane), the torque
         // spring and LAMMPS' SDS, from states below and beyond their caps.

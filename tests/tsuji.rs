@@ -51,7 +51,7 @@ fn tsuji_damping_realises_the_restitution_of_its_beta() {
 }
 
 #[test]
-fn tsuji_damping_is_refused_with_the_incremental_force_and_by_liggghts_and_yade() {
+fn tsuji_damping_is_refused_with_the_incremental_force_the_spring_kept_cap_and_by_liggghts_and_yade() {
     let mut s = grainlab::scene::builtin::builtin("collision").unwrap();
     s.model.damping = DampingSpec::Tsuji;
     for code in [grainlab::workbench::export::Code::Liggghts, grainlab::workbench::export::Code::Yade] {
@@ -59,8 +59,10 @@ fn tsuji_damping_is_refused_with_the_incremental_force_and_by_liggghts_and_yade(
         assert!(e.contains(&format!("export to {}: model.damping = \"tsuji\" cannot be expressed", code.name())), "{e}");
     }
     assert!(grainlab::workbench::export::export_files(&s, grainlab::workbench::export::Code::Lammps, false, &Default::default()).is_ok());
-    s.model.tangential = TangentialSpec::IncrementalForce;
-    let e = grainlab::Scene::from_json(&s.to_json()).expect_err("not compiled").to_string();
-    assert!(e.contains("model.damping = tsuji") && e.contains("compiled:"), "{e}");
+    for form in [TangentialSpec::IncrementalForce, TangentialSpec::TotalForceCapSpringKept] {
+        s.model.tangential = form;
+        let e = grainlab::Scene::from_json(&s.to_json()).expect_err("not compiled").to_string();
+        assert!(e.contains("model.damping = tsuji") && e.contains(form.name()) && e.contains("compiled:"), "{e}");
+    }
 }
 

@@ -396,6 +396,8 @@ pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<B
         (None, TangentialSpec::TotalDisplacement, true) => parts.assemble(LiggghtsHertzHistoryElastic::new(options, Hertz))?,
         (None, TangentialSpec::TotalForceCap, false) => parts.assemble(HertzForceCap::new(options, Hertz))?,
         (None, TangentialSpec::TotalForceCap, true) => parts.assemble(HertzForceCapElastic::new(options, Hertz))?,
+        (None, TangentialSpec::TotalForceCapSpringKept, false) => parts.assemble(HertzSpringKept::new(options, Hertz))?,
+        (None, TangentialSpec::TotalForceCapSpringKept, true) => parts.assemble(HertzSpringKeptElastic::new(options, Hertz))?,
         (None, TangentialSpec::IncrementalForce, false) => parts.assemble(YadeMindlin::new(options, Hertz))?,
         (None, TangentialSpec::IncrementalForce, true) => parts.assemble(YadeMindlinElastic::new(options, Hertz))?,
         (Some(h), TangentialSpec::Frictionless, false) => parts.assemble(HookeFrictionless::new(options, h))?,
@@ -404,6 +406,8 @@ pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<B
         (Some(h), TangentialSpec::TotalDisplacement, true) => parts.assemble(LiggghtsHookeHistoryElastic::new(options, h))?,
         (Some(h), TangentialSpec::TotalForceCap, false) => parts.assemble(HookeForceCap::new(options, h))?,
         (Some(h), TangentialSpec::TotalForceCap, true) => parts.assemble(HookeForceCapElastic::new(options, h))?,
+        (Some(h), TangentialSpec::TotalForceCapSpringKept, false) => parts.assemble(HookeSpringKept::new(options, h))?,
+        (Some(h), TangentialSpec::TotalForceCapSpringKept, true) => parts.assemble(HookeSpringKeptElastic::new(options, h))?,
         (Some(h), TangentialSpec::IncrementalForce, false) => parts.assemble(HookeIncremental::new(options, h))?,
         (Some(h), TangentialSpec::IncrementalForce, true) => parts.assemble(HookeIncrementalElastic::new(options, h))?,
     };

@@ -98,6 +98,7 @@ impl Effects {
         let form = match scene.model.tangential {
             TangentialSpec::TotalDisplacement => "total displacement (LIGGGHTS' history)",
             TangentialSpec::TotalForceCap => "total displacement, cap on the total force (LAMMPS' history)",
+            TangentialSpec::TotalForceCapSpringKept => "total displacement, cap on the total force with the spring kept (Kratos' rule)",
             TangentialSpec::IncrementalForce => "incremental force (YADE's)",
             TangentialSpec::Frictionless => "none",
         };
@@ -109,6 +110,7 @@ impl Effects {
         let measured = match scene.model.tangential {
             TangentialSpec::IncrementalForce => "incremental force (YADE's)",
             TangentialSpec::TotalForceCap => "total force cap (LAMMPS')",
+            TangentialSpec::TotalForceCapSpringKept => "total force cap, spring kept (Kratos')",
             _ => "frictionless (no tangential, no spin stage)",
         };
         push("friction (tangential force)", friction, friction_why, Some(measured));

@@ -313,6 +313,14 @@ pub enum TangentialSpec {
     /// length when the contact frame turns. The friction impulse never exceeds mu times
     /// the normal one (docs/model.md).
     TotalForceCap,
+    /// The cap on the total tangential force with the spring kept (the rule of Kratos
+    /// DEMApplication's `DEM_D_Hertz_viscous_Coulomb` on LIGGGHTS' total displacement):
+    /// while sliding the total force is mu |Fn| exactly, the spring keeps its displacement
+    /// (scaled to the cap only if it alone exceeds it) and the dashpot takes the rest. The
+    /// friction impulse of a gross slide is mu times the normal one, damped Hertz included
+    /// (docs/model.md). No reference code has it: exports write the nearest law with a
+    /// `# Differs:` line.
+    TotalForceCapSpringKept,
     /// YADE `Law2_ScGeom_MindlinPhys_Mindlin`.
     IncrementalForce,
     /// No tangential force (and no spin).
@@ -325,6 +333,7 @@ impl TangentialSpec {
         match self {
             TangentialSpec::TotalDisplacement => "total_displacement",
             TangentialSpec::TotalForceCap => "total_force_cap",
+            TangentialSpec::TotalForceCapSpringKept => "total_force_cap_spring_kept",
             TangentialSpec::IncrementalForce => "incremental_force",
             TangentialSpec::Frictionless => "frictionless",
         }

@@ -172,7 +172,9 @@ impl Scene {
                 check(false, &format!("materials[{k}]"), "restitution", 0.0, "(0, 1] with model.damping = clamped_restitution (under the clamp e -> 0 needs infinite damping; without the clamp, the default damping's e = 0 keeps the grains together)")?;
             }
         }
-        check(!(tsuji && self.model.tangential == TangentialSpec::IncrementalForce), "model", "damping", "tsuji", &format!("\"restitution\" with model.tangential = incremental_force (compiled: {})", crate::physics::contact::model::COMPILED))?;
+        if tsuji && matches!(self.model.tangential, TangentialSpec::IncrementalForce | TangentialSpec::TotalForceCapSpringKept) {
+            check(false, "model", "damping", "tsuji", &format!("\"restitution\" with model.tangential = {} (compiled: {})", self.model.tangential.name(), crate::physics::contact::model::COMPILED))?;
+        }
         // DMT cohesion is compiled with the restitution damping, frictionless or with the
         // total displacement, and without the clamp (which would remove the attraction).
         if let Some((k, m)) = self.adhesive_material() {

@@ -13,7 +13,7 @@ use super::cohesion::{Cohesion, Dmt, NoCohesion};
 use super::rolling::{Cdt, Epsd2, InLanes, NoRolling, Rolling, RollingEnergy, RollingInput, Sds};
 use super::damping::{Damping, LinearRestitution, TsujiFit, Undamped, Viscoelastic};
 use super::normal::{Hertz, Hooke, Normal};
-use super::tangential::{Frictionless, IncrementalForce, Tangential, TangentialForce, TangentialInput, TotalDisplacement, TotalForceCap};
+use super::tangential::{Frictionless, IncrementalForce, Tangential, TangentialForce, TangentialInput, TotalDisplacement, TotalForceCap, TotalForceCapSpringKept};
 use crate::physics::dim::Vec2;
 use crate::physics::energy::{EnergyLedger, EnergySums};
 use crate::physics::lanes::{Real, k, pick};
@@ -551,6 +551,14 @@ pub type HookeForceCap = ContactModel<Hooke, LinearRestitution, TotalForceCap>;
 pub type HookeForceCapElastic = ContactModel<Hooke, Undamped, TotalForceCap>;
 pub type HookeTsujiForceCap = ContactModel<Hooke, TsujiFit, TotalForceCap>;
 
+/// The cap on the total tangential force with the spring kept (`model.tangential =
+/// "total_force_cap_spring_kept"`, Kratos' rule): gross sliding exact under damped Hertz,
+/// with the restitution damping or none.
+pub type HertzSpringKept = ContactModel<Hertz, Viscoelastic, TotalForceCapSpringKept>;
+pub type HertzSpringKeptElastic = ContactModel<Hertz, Undamped, TotalForceCapSpringKept>;
+pub type HookeSpringKept = ContactModel<Hooke, LinearRestitution, TotalForceCapSpringKept>;
+pub type HookeSpringKeptElastic = ContactModel<Hooke, Undamped, TotalForceCapSpringKept>;
+
 /// LAMMPS `pair granular ... damping tsuji` (`model.damping = "tsuji"`), either normal
 /// law, frictionless or with the total-displacement history.
 pub type HertzTsujiFrictionless = ContactModel<Hertz, TsujiFit, Frictionless>;
@@ -577,4 +585,4 @@ pub type HookeHistoryEpsd2 = ContactModel<Hooke, LinearRestitution, TotalDisplac
 pub type HookeHistorySds = ContactModel<Hooke, LinearRestitution, TotalDisplacement, NoCohesion, Sds>;
 
 /// The names of the compiled combinations, for a refusal.
-pub const COMPILED: &str = "normal hertz or hooke (hooke_stiffness), each with damping (beta(e); the linear spring's constant-restitution form) or none (every e = 1), and tangential total_displacement, total_force_cap, incremental_force or frictionless; damping tsuji with either normal law, total_displacement, total_force_cap or frictionless; cohesion (work_of_adhesion > 0) with either normal law, the restitution damping, total_displacement or frictionless, without limit_force; rolling (cdt, epsd2, sds) with either normal law, the restitution damping and total_displacement, without cohesion";
+pub const COMPILED: &str = "normal hertz or hooke (hooke_stiffness), each with damping (beta(e); the linear spring's constant-restitution form) or none (every e = 1), and tangential total_displacement, total_force_cap, total_force_cap_spring_kept, incremental_force or frictionless; damping tsuji with either normal law, total_displacement, total_force_cap or frictionless; cohesion (work_of_adhesion > 0) with either normal law, the restitution damping, total_displacement or frictionless, without limit_force; rolling (cdt, epsd2, sds) with either normal law, the restitution damping and total_displacement, without cohesion";

@@ -252,3 +252,90 @@ impl Tangential for TotalForceCap {
         TangentialForce { elastic: pick2(none, Vector2::zeros(), elastic), damping: pick2(none, Vector2::zeros(), damping), slip_energy }
     }
 }
+
+/// The cap on the total tangential force with the spring kept (`model.tangential =
+/// "total_force_cap_spring_kept"`), the rule of Kratos DEMApplication's
+/// `DEM_D_Hertz_viscous_Coulomb` (Chung & Ooi's benchmarks as Kratos runs them) on
+/// LIGGGHTS' total displacement: `xi += vt dt`, projected onto the tangent line, and
+/// `Ft = -kt xi - gt vt` while `|Ft| <= mu |Fn|`. Above it the contact slides and the
+/// total force is the trial one scaled to the cap, `mu |Fn|` exactly; the spring keeps its
+/// own displacement unless it alone exceeds the cap (then it is scaled to it, as
+/// LIGGGHTS'), and the dashpot takes the rest, so it never stores the dashpot's force
+/// (as LAMMPS' law does) nor adds it above the cap (as LIGGGHTS' and YADE's do while
+/// sticking). In gross sliding the friction impulse is mu times the normal impulse to
+/// rounding, under damped Hertz too (tests/chung_ooi.rs, tests 4, 6 and 8).
+///
+/// The split for the energy ledger: elastic `-kt xi`, viscous the rest of the force
+/// (against the slip: it dissipates); friction takes what a slip removes from the spring.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct TotalForceCapSpringKept;
+
+impl Tangential for TotalForceCapSpringKept {
+    const NAME: &'static str = "TotalForceCapSpringKept";
+    const FRICTION: bool = true;
+    displacement_history!();
+    #[inline(always)]
+    fn force<R: Real>(xi: &mut Vector2<R>, inp: &TangentialInput<R>) -> TangentialForce<R> {
+        let n = inp.n;
+        *xi += inp.vt * inp.dt;
+        let along_n = xi.dot(&n);
+        *xi -= n * along_n;
+        let elastic = *xi * -inp.kt;
+        let damping = inp.vt * -inp.gt;
+        let trial = elastic + damping;
+        let f = trial.norm();
+        // cap >= 0, so a sliding contact has f > 0 (and a spring over the cap f_el > 0).
+        let slide = f.simd_gt(inp.cap);
+        let f_el = elastic.norm();
+        let over = slide & f_el.simd_gt(inp.cap);
+        let scale = pick(over, inp.cap / f_el, R::one());
+        let before = k::<R>(0.5) * inp.kt * xi.norm_squared();
+        *xi = *xi * scale;
+        let after = k::<R>(0.5) * inp.kt * xi.norm_squared();
+        let kept = *xi * -inp.kt;
+        // Sliding: the trial force at the cap, of which the dashpot takes what the spring
+        // does not hold (along the trial, against the slip).
+        let total = trial * (inp.cap / f);
+        TangentialForce { elastic: kept, damping: pick2(slide, total - kept, damping), slip_energy: pick(over, before - after, R::zero()) }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// One step of the spring-kept cap from history `xi` (m) along x, the normal along y,
+    /// at tangential velocity `vt` (m/s), kt = 1e4 N/m, gt = 2 kg/s, dt = 1e-4 s, cap in N.
+    fn step(xi: f64, vt: f64, cap: f64) -> (Vector2<f64>, TangentialForce<f64>) {
+        let mut h = Vector2::new(xi, 0.0);
+        let inp = TangentialInput { n: Vector2::new(0.0, 1.0), vt: Vector2::new(vt, 0.0), kt: 1e4, gt: 2.0, cap, dt: 1e-4 };
+        let f = TotalForceCapSpringKept::force(&mut h, &inp);
+        (h, f)
+    }
+
+    #[test]
+    fn spring_kept_cap_sticks_below_the_cap_and_slides_at_it() {
+        // Sticking: spring -kt (xi + vt dt) = -1e4 (1e-4 + 1e-4) = -2 N, dashpot -2 N:
+        // 4 N total, under a 5 N cap: both as computed, no slip.
+        let (h, f) = step(1e-4, 1.0, 5.0);
+        assert_eq!((f.elastic.x, f.damping.x, f.slip_energy, h.x), (-2.0, -2.0, 0.0, 2e-4));
+        // The spring below the cap, the total above (3 N cap): the total is the cap, the
+        // spring keeps its displacement and the dashpot takes 1 N, against the slip.
+        let (h, f) = step(1e-4, 1.0, 3.0);
+        assert_eq!((f.elastic.x, h.x, f.slip_energy), (-2.0, 2e-4, 0.0));
+        assert!((f.elastic.x + f.damping.x + 3.0).abs() < 1e-15 && (f.damping.x + 1.0).abs() < 1e-15, "{f:?}");
+        // The spring alone above the cap (1.5 N): scaled to it, no dashpot, and the slip
+        // takes kt (|xi|^2 - |xi'|^2) / 2 = 1e4 (4e-8 - 2.25e-8) / 2 = 8.75e-5 J.
+        let (h, f) = step(1e-4, 1.0, 1.5);
+        assert!((f.elastic.x + 1.5).abs() < 1e-15 && f.damping.x.abs() < 1e-15 && (h.x - 1.5e-4).abs() < 1e-19, "{f:?} {h:?}");
+        assert!((f.slip_energy - 8.75e-5).abs() < 1e-18, "{}", f.slip_energy);
+        // The dashpot opposite a spring that is released (vt against xi): spring -1e4 (5e-4
+        // - 1e-4) = -4 N, dashpot +2 N, total -2 N under a 3 N cap: sticks.
+        let (_, f) = step(5e-4, -1.0, 3.0);
+        assert_eq!((f.elastic.x, f.damping.x), (-4.0, 2.0));
+        // Fast the other way (vt = -10): spring -1e4 (5e-4 - 1e-3) = 5 N, dashpot 20 N,
+        // 25 N against a 3 N cap: the spring scaled to 3 N, the total 3 N, no dashpot left.
+        let (h, f) = step(5e-4, -10.0, 3.0);
+        assert!((f.elastic.x - 3.0).abs() < 1e-15 && f.damping.x.abs() < 1e-15 && (h.x + 3e-4).abs() < 1e-19, "{f:?} {h:?}");
+    }
+}

@@ -137,7 +137,7 @@ const MATERIAL_M: &str = "flat: the wall/gran fixes take the coefficients of the
 const MODULI_M: &str = "each pair of atom types' `pair_coeff I J hertz KN ...` with KN = 4/3 E* and `tangential mindlin KT ...` with KT = 8 G*, mixed by grainlab (LAMMPS' hertz/material would take a given pair as one material, and mixes the pairs not given its own way); the derived spring's kn from E*";
 const SPRING_REFUSED_M: &str = "the derived spring where a pair of atom types, or a flat wall and a material of the free grains, meets at more than one kn (grains of several sizes or masses): LAMMPS' `hooke` takes one kn per pair of types and per wall fix";
 const SPRING_M: &str = "`hooke KN` and `tangential linear_history KT` in every pair_coeff and wall/gran fix; `damping tsuji` damps each contact with its own sqrt(m* kn), so grains of every size and mass are exact";
-const TANGENTIAL_M: &str = "LAMMPS' total-displacement history (grainlab's total_force_cap) caps the total tangential force (elastic and damping) and, on slip, keeps the displacement that gives the cap with the damping; between grains it rescales the history to its length when the contact frame turns. grainlab's total_displacement caps the elastic force alone and projects the history: frictional contacts with damping (e < 1), and frictional grain pairs, differ (head-on and frictionless impacts, and a grain on a flat wall at e = 1, agree); incremental_force is YADE's law, which differs more";
+const TANGENTIAL_M: &str = "LAMMPS' total-displacement history (grainlab's total_force_cap) caps the total tangential force (elastic and damping) and, on slip, keeps the displacement that gives the cap with the damping; between grains it rescales the history to its length when the contact frame turns. grainlab's total_displacement caps the elastic force alone and projects the history: frictional contacts with damping (e < 1), and frictional grain pairs, differ (head-on and frictionless impacts, and a grain on a flat wall at e = 1, agree); total_force_cap_spring_kept caps the total too but keeps the spring's own displacement on slip (no reference code has it), and projects; incremental_force is YADE's law, which differs more";
 const NORMAL_Y: &str = "hertz: FrictMat and Ip2_FrictMat_FrictMat_MindlinPhys; hooke, hooke_stiffness: ViscElMat(kn, ks, cn, cs) per material and per flat wall (KN, KS, CN, CS, WALL_*), which Ip2_ViscElMat_ViscElMat_ViscElPhys puts in series per contact, solved by grainlab from its pairs' kn, kt, 2 |beta| sqrt(m* k), and Law2_ScGeom_ViscElPhys_Basic";
 const SPRING_REFUSED_Y: &str = "a pair of materials (or a flat wall and a material) whose contacts meet at more than one stiffness or damping rate (the derived spring, or damping, of grains of several sizes or masses), or whose values no per-material values in series give: YADE's ViscElMat gives each body one spring and one dashpot, and a contact the two in series";
 const SPRING_Y: &str = "the KN, KS (and CN, CS) lists of ViscElMat: twice the pair's value for a material's own grains, the series partner for a flat wall (grainlab's kn, kt per pair, as derived or given)";
@@ -325,13 +325,13 @@ pub const FIELDS: &[Field] = &[
     each(
         "model.tangential",
         written("total_displacement: `pair_style gran model hertz tangential history`; frictionless: coefficientFriction 0 (Ft = 0) and `nve`")
-            .or_differs("incremental_force, total_force_cap", "LIGGGHTS has only the total-displacement history, which caps the elastic force alone; head-on impacts agree, oblique ones differ (incremental_force: rebound spin up to 2x; total_force_cap: frictional contacts with damping)"),
+            .or_differs("incremental_force, total_force_cap, total_force_cap_spring_kept", "LIGGGHTS has only the total-displacement history, which caps the elastic force alone; head-on impacts agree, oblique ones differ (incremental_force: rebound spin up to 2x; total_force_cap, total_force_cap_spring_kept: frictional contacts with damping)"),
         written("incremental_force: Law2_ScGeom_MindlinPhys_Mindlin; frictionless: frictionAngle 0 (Ft = 0)")
-            .or_differs("total_displacement, total_force_cap", "YADE's Mindlin law adds force increments; head-on impacts agree, oblique ones differ (rebound spin up to 2x)"),
+            .or_differs("total_displacement, total_force_cap, total_force_cap_spring_kept", "YADE's Mindlin law adds force increments; head-on impacts agree, oblique ones differ (rebound spin up to 2x)"),
     )
     .in_lammps(
         written("total_force_cap (LAMMPS' own law) and total_displacement: `tangential mindlin` (Hertz) or `tangential linear_history` (linear spring), a total tangential displacement; frictionless: MU 0 (Ft = 0) and `nve`")
-            .or_differs("total_displacement, incremental_force", TANGENTIAL_M),
+            .or_differs("total_displacement, total_force_cap_spring_kept, incremental_force", TANGENTIAL_M),
     ),
     each(
         "model.limit_force",

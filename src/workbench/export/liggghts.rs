@@ -74,7 +74,7 @@ pub(crate) fn deck(scene: &Scene, ex: &Exported, code: Code) -> Result<String, E
         if model.lever_arm != LeverArm::RadiusMinusHalfOverlap && frictional {
             let _ = writeln!(w, "{}", differs_line(code, "model.lever_arm", name_of(&model.lever_arm)));
         }
-        if matches!(model.tangential, TangentialSpec::IncrementalForce | TangentialSpec::TotalForceCap) {
+        if matches!(model.tangential, TangentialSpec::IncrementalForce | TangentialSpec::TotalForceCap | TangentialSpec::TotalForceCapSpringKept) {
             let _ = writeln!(w, "{}", differs_line(code, "model.tangential", name_of(&model.tangential)));
         }
     }

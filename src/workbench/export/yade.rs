@@ -67,7 +67,7 @@ pub(crate) fn deck(scene: &Scene, ex: &Exported) -> Result<String, Error> {
     let _ = writeln!(w, "# regenerate with `grainlab export yade SCENE --out DIR`.");
     let _ = writeln!(w, "# Run in this directory: yade -n -x yade.py (reads grains.data, writes series.txt).");
     let _ = writeln!(w, "# Recorded between the contact law and the integrator: positions x(n), force F(x(n)), velocities v(n-1/2).");
-    if matches!(model.tangential, TangentialSpec::TotalDisplacement | TangentialSpec::TotalForceCap) {
+    if matches!(model.tangential, TangentialSpec::TotalDisplacement | TangentialSpec::TotalForceCap | TangentialSpec::TotalForceCapSpringKept) {
         let _ = writeln!(w, "{}", differs_line(Code::Yade, "model.tangential", name_of(&model.tangential)));
     }
     if !model.limit_force {
