@@ -18,7 +18,7 @@ def rows(test):
 
 
 SHAPES = [("sphere_in_plane", "sphere in the plane", "o"), ("disk", "disk", "s")]
-FORMS = [("total_displacement", "C0"), ("incremental_force", "C3")]
+FORMS = [("total_displacement", "C0"), ("incremental_force", "C3"), ("total_force_cap", "C2"), ("total_force_cap_spring_kept", "C4")]
 
 
 def series(rs, shape, form, quantity):
@@ -27,17 +27,28 @@ def series(rs, shape, form, quantity):
 
 
 # Test 3: realised against input restitution.
-fig, ax = plt.subplots(figsize=(5, 4))
+fig, ax = plt.subplots(figsize=(8.5, 4))
 t3 = rows("test_3")
 for (shape, label, marker) in SHAPES:
     for mat, color in [("Al2O3", "C0"), ("cast_iron", "C1")]:
         p = series(t3, shape, mat, "restitution_normal")
         ax.plot([x for x, _, _ in p], [y for _, y, _ in p], marker, mfc="none", color=color, label=f"{mat.replace('_', ' ')}, {label}")
 ax.plot([0, 1], [0, 1], "k-", lw=0.8, label="input e (closed form)")
+# Under the clamp (test_3_clamped): the clamped damping returns e; beta(e) returns more,
+# on its own closed form.
+t3c = rows("test_3_clamped")
+for (shape, label, marker) in SHAPES:
+    for mat, color in [("Al2O3", "C0"), ("cast_iron", "C1")]:
+        p = series(t3c, shape, mat, "restitution_normal")
+        ax.plot([x for x, _, _ in p], [y for _, y, _ in p], "^" if shape == "disk" else "v", mfc="none", color=color, ms=5, label=f"{mat.replace('_', ' ')}, {label}, clamp + clamped_restitution")
+        p = series(t3c, shape, mat + "_beta_e", "restitution_normal")
+        ax.plot([x for x, _, _ in p], [y for _, y, _ in p], "x", color=color, ms=5, label=f"{mat.replace('_', ' ')}, {label}, clamp + beta(e)")
+c = sorted((x, cf) for x, _, cf in series(t3c, "sphere_in_plane", "Al2O3_beta_e", "restitution_normal"))
+ax.plot([x for x, _ in c], [y for _, y in c], "k--", lw=0.8, label="beta(e) under the clamp (closed form)")
 ax.set_xlabel("input e")
 ax.set_ylabel("realised e")
-ax.set_title("Test 3: restitution on a rigid plane (t_c/1000, no clamp)")
-ax.legend(fontsize=7)
+ax.set_title("Test 3: restitution on a rigid plane (t_c/1000)")
+ax.legend(fontsize=6, loc="center left", bbox_to_anchor=(1.02, 0.5))
 fig.tight_layout()
 fig.savefig(os.path.join(OUT, "test_3.png"), dpi=110)
 
@@ -94,6 +105,36 @@ fig.suptitle("Test 6: Al on a rigid plane, vn = 0.2 m/s, e = 0.5, mu = 0.4 (clam
 fig.tight_layout()
 fig.savefig(os.path.join(OUT, "test_6.png"), dpi=110)
 
+# Against the paper's curves (tests/data/chung_ooi_paper, Kratos' digitisation): test 6's
+# beta against x, test 5's spin against tan(angle) / mu, every formulation.
+fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
+tp = rows("paper")
+ax = axes[0]
+for form, color in FORMS:
+    p = series(tp, "sphere_in_plane", form, "test6_beta")
+    ax.plot([x for x, _, _ in p], [y for _, y, _ in p], "o-", mfc="none", color=color, ms=5, lw=0.6, label=f"grainlab {form.replace('_', ' ')} (clamped damping)")
+p = series(tp, "sphere_in_plane", "total_displacement", "test6_beta")
+ax.plot([x for x, _, _ in p], [c for _, _, c in p], "k-", lw=1.2, label="Chung & Ooi (2011), test 6 (Kratos' digitisation)")
+ax.plot([0.15, 1.0], [-0.85, 0.0], "k:", lw=0.8, label="gross sliding, beta = x - 1")
+ax.axvspan(0.1, 1.0, color="0.93", lw=0)
+ax.set_xscale("log")
+ax.set_xlabel("x = 3.5 mu (1 + e) vn / |v_c0|")
+ax.set_ylabel("beta = -v_c' / v_c0")
+ax.set_title("Test 6: Al sphere on a plane, e = 0.5, mu = 0.4 (shaded: sliding)", fontsize=9)
+ax.legend(fontsize=6)
+ax = axes[1]
+for form, color in FORMS:
+    p = series(tp, "sphere_in_plane", form, "test5_spin")
+    ax.plot([x for x, _, _ in p], [y for _, y, _ in p], "o-", mfc="none", color=color, ms=5, lw=0.6, label=f"grainlab {form.replace('_', ' ')}")
+p = series(tp, "sphere_in_plane", "total_displacement", "test5_spin")
+ax.plot([x for x, _, _ in p], [c for _, _, c in p], "k-", lw=1.2, label="Chung & Ooi (2011), steel (Kratos' digitisation)")
+ax.set_xlabel("tan(incident angle) / mu")
+ax.set_ylabel("rebound spin r w' / (mu vn)")
+ax.set_title("Test 5: steel sphere on a plane, e = 1, mu = 0.3", fontsize=9)
+ax.legend(fontsize=6)
+fig.tight_layout()
+fig.savefig(os.path.join(OUT, "paper.png"), dpi=110)
+
 # Tests 1 and 2: a table.
 table = ["| test | material | shape | quantity | grainlab | closed form | difference |", "|---|---|---|---|---:|---:|---:|"]
 names = {"test_1": {1.0: "glass", 2.0: "limestone"}, "test_2": {1.0: "Al", 2.0: "Mg"}}
@@ -107,4 +148,4 @@ start, end = "<!-- results: scripts/benchmark-docs -->", "<!-- /results -->"
 i, j = md.index(start) + len(start), md.index(end)
 md = md[:i] + "\n" + "\n".join(table) + "\n" + md[j:]
 open(md_path, "w").write(md)
-print("wrote docs/benchmarks.md and docs/benchmarks/test_3.png, test_4.png, test_6.png")
+print("wrote docs/benchmarks.md and docs/benchmarks/test_3.png, test_4.png, test_6.png, paper.png")

@@ -212,11 +212,12 @@ fn test_3_under_the_clamp_the_clamped_damping_returns_the_input_restitution() {
                 let imp = run(&s);
                 rows.add(shape, if mat.youngs_modulus > 2e11 { "Al2O3" } else { "cast_iron" }, e, "restitution_normal", imp.restitution_normal, Some(e));
                 assert!((imp.restitution_normal - e).abs() < 0.3 / 1000.0, "E = {} {shape:?} e = {e}: realised {}", mat.youngs_modulus, imp.restitution_normal);
-                if e == 0.1 {
-                    let plain = run(&on_plane(grain, shape, 2.5e-3, 3.9, 0.0, 0.0, 1000.0, TangentialSpec::Frictionless, true));
-                    let closed = grainlab::physics::restitution::clamped_restitution(-grainlab::physics::restitution::beta(e));
-                    assert!((plain.restitution_normal - closed).abs() < 0.3 / 1000.0 && closed > 0.25, "beta(e) under the clamp: realised {}, closed form {closed}", plain.restitution_normal);
-                }
+                // The default damping's beta(e) under the clamp: its own closed form.
+                let plain = run(&on_plane(grain, shape, 2.5e-3, 3.9, 0.0, 0.0, 1000.0, TangentialSpec::Frictionless, true));
+                let closed = grainlab::physics::restitution::clamped_restitution(-grainlab::physics::restitution::beta(e));
+                rows.add(shape, if mat.youngs_modulus > 2e11 { "Al2O3_beta_e" } else { "cast_iron_beta_e" }, e, "restitution_normal", plain.restitution_normal, Some(closed));
+                assert!((plain.restitution_normal - closed).abs() < 0.3 / 1000.0, "beta(e) under the clamp at e = {e}: realised {}, closed form {closed}", plain.restitution_normal);
+                assert!(e != 0.1 || closed > 0.25, "{closed}");
             }
         }
     }
@@ -449,6 +450,89 @@ fn test_8_a_small_sphere_on_a_larger_denser_one() {
                 let dvt = imp.rebound_tangential_velocity_m_s;
                 assert!(rel(dvt, -slip * 0.4 * dvn) < 1e-3, "{what}, e = 1: dvt {dvt} vs -mu dvn {}", -slip * 0.4 * dvn);
             }
+        }
+    }
+}
+
+/// One curve of the paper's figures as Kratos digitised them (tests/data/chung_ooi_paper,
+/// cited there): its (x, y) points.
+fn paper(file: &str, curve: &str) -> Vec<(f64, f64)> {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/chung_ooi_paper").join(file);
+    let text = std::fs::read_to_string(&path).expect("the digitised curves are committed");
+    text.lines()
+        .skip(1)
+        .filter_map(|l| {
+            let f: Vec<&str> = l.split(',').collect();
+            (f[0] == curve).then(|| (f[1].parse().unwrap(), f[2].parse().unwrap()))
+        })
+        .collect()
+}
+
+/// Kratos' measure of a curve against the paper's: the sum of absolute differences over
+/// the sum of the paper's absolute values.
+fn kratos_error(ours: &[f64], paper: &[(f64, f64)]) -> f64 {
+    ours.iter().zip(paper).map(|(a, (_, p))| (a - p).abs()).sum::<f64>() / paper.iter().map(|(_, p)| p.abs()).sum::<f64>()
+}
+
+/// Test 6 at the paper's abscissa x = 3.5 mu (1 + e) vn / |v_c0| (a sphere on a rigid
+/// plane, spin only): beta = -v_c' / v_c0, the contact point's tangential restitution.
+fn test_6_beta(x: f64, form: TangentialSpec, damping: DampingSpec) -> f64 {
+    let mat = material(70e9, 0.33, 2700.0, 0.5, 0.4);
+    let ratio = 3.5 * 0.4 * 1.5 / x;
+    let mut s = on_plane(mat, GrainShape::SphereInPlane, 0.1, 0.2, 0.0, -ratio * 0.2 / 0.1, 500.0, form, true);
+    s.model.damping = damping;
+    let imp = run(&s);
+    let vc0 = -ratio * 0.2;
+    -(imp.rebound_tangential_velocity_m_s + 0.1 * imp.rebound_spin_rad_s) / vc0
+}
+
+/// Test 5 at the paper's abscissa x = tan(angle) / mu (steel, R = 10 um, vn = 5 m/s,
+/// e = 1): the rebound spin r w' / (mu vn).
+fn test_5_spin(x: f64, form: TangentialSpec) -> f64 {
+    let mat = material(208e9, 0.3, 7850.0, 1.0, 0.3);
+    let s = on_plane(mat, GrainShape::SphereInPlane, 1e-5, 5.0, 5.0 * 0.3 * x, 0.0, 500.0, form, false);
+    let imp = run(&s);
+    1e-5 * imp.rebound_spin_rad_s / (0.3 * 5.0)
+}
+
+#[test]
+fn tests_5_and_6_meet_the_papers_sliding_curves_within_kratos_tolerance() {
+    // The paper's curves (Kratos' digitisation) where the contact slides, measured as
+    // Kratos measures them and against its bounds: test 6's first six points (x = 0.19 to
+    // 1.21, beta; 3%), test 5's finite-element points at x = 7 to 19 (the spin; 2%).
+    // Test 6 with the variant that models what the paper assumes: the realised e is the
+    // input 0.5 (the clamped damping) and the friction impulse mu J (the spring-kept cap):
+    // measured 2.6%: 1.1 from the sixth point (x = 1.21, past the sliding threshold, where
+    // the paper's micro-slip acts) and 1.5 from the five sliding ones, which is the
+    // digitisation's own scatter (the closed form x - 1 is 1.5% from them, and these runs
+    // within 1.5e-4 of it). The other formulations miss it (15-37%:
+    // the friction impulse is not mu J under damped Hertz), the control. Test 5 is undamped
+    // (e = 1): every formulation slides alike there (0.71%). The whole diagrams, sticking
+    // regime included, are written for the plots of docs/benchmarks.md (issue 32: the
+    // paper's sticking curves include Mindlin-Deresiewicz micro-slip, which no formulation
+    // here models).
+    let mut rows = Rows::new("paper");
+    let t6 = paper("test6_beta.csv", "test6");
+    for form in FORMS {
+        let ours: Vec<f64> = t6.iter().map(|&(x, _)| test_6_beta(x, form, DampingSpec::ClampedRestitution)).collect();
+        for (&(x, p), &b) in t6.iter().zip(&ours) {
+            rows.add(GrainShape::SphereInPlane, form_name(form), x, "test6_beta", b, Some(p));
+        }
+        let err6 = kratos_error(&ours[..6], &t6[..6]);
+        if form == TangentialSpec::TotalForceCapSpringKept {
+            assert!(err6 < 0.03, "test 6, {form:?}: {err6:e} of the paper's curve (Kratos' bound 3%)");
+        } else {
+            assert!(err6 > 0.1, "test 6, {form:?}: {err6:e}, the control: the friction impulse is not mu J here");
+        }
+    }
+    let fem = paper("test5_spin.csv", "fem");
+    let sliding = &fem[fem.len() - 4..];
+    for form in FORMS {
+        let ours: Vec<f64> = sliding.iter().map(|&(x, _)| test_5_spin(x, form)).collect();
+        let err5 = kratos_error(&ours, sliding);
+        assert!(err5 < 0.02, "test 5, {form:?}: {err5:e} of the paper's curve (Kratos' bound 2%)");
+        for &(x, p) in &paper("test5_spin.csv", "steel") {
+            rows.add(GrainShape::SphereInPlane, form_name(form), x, "test5_spin", test_5_spin(x, form), Some(p));
         }
     }
 }
