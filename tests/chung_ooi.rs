@@ -8,8 +8,10 @@
 //! ([`builtin::on_rigid_plane`]): E* and G* then differ from the grain's own E/(1 - nu^2)
 //! and E/(2(2 - nu)(1 + nu)) by 1e-19 relative.
 //!
-//! Gross sliding: while a contact slides, both tangential formulations give a tangential
-//! force of exactly mu |Fn| (no damping), along the tangent line. With the normal force
+//! Gross sliding: while a contact slides, LIGGGHTS' and YADE's formulations give a
+//! tangential force of exactly mu |Fn| (no damping), along the tangent line, and so does
+//! the spring-kept cap (its total force at the cap; LAMMPS' law keeps the dashpot's force
+//! in its spring). With the normal force
 //! clamped at Fn >= 0 (`limit_force`), the tangential impulse is then exactly mu times
 //! the normal impulse: the grain's tangential velocity changes by mu times its normal
 //! velocity change, and its spin by kappa / r times that (kappa = m r^2 / I: 5/2 for the
@@ -17,6 +19,9 @@
 //! the normal force turns attractive at the end of a damped contact, |Fn| exceeds Fn
 //! there, and the identity fails by design (issue 32's LAMMPS-like law caps it); these
 //! tests clamp wherever e < 1.
+//!
+//! Against the paper itself: its curves as Kratos digitised them (tests/data/chung_ooi_paper),
+//! by Kratos' measure and bounds where the contact slides.
 
 use grainlab::physics::dim::GrainShape;
 use grainlab::physics::material::{Material, PairMaterial, hertz_contact_time, hertz_contact_time_exact, hertz_max_overlap};
