@@ -109,29 +109,24 @@ fig.savefig(os.path.join(OUT, "test_6.png"), dpi=110)
 # beta against x, test 5's spin against tan(angle) / mu, every formulation.
 fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
 tp = rows("paper")
-ax = axes[0]
-for form, color in FORMS:
-    p = series(tp, "sphere_in_plane", form, "test6_beta")
-    ax.plot([x for x, _, _ in p], [y for _, y, _ in p], "o-", mfc="none", color=color, ms=5, lw=0.6, label=f"grainlab {form.replace('_', ' ')} (clamped damping)")
-p = series(tp, "sphere_in_plane", "total_displacement", "test6_beta")
-ax.plot([x for x, _, _ in p], [c for _, _, c in p], "k-", lw=1.2, label="Chung & Ooi (2011), test 6 (Kratos' digitisation)")
-ax.plot([0.15, 1.0], [-0.85, 0.0], "k:", lw=0.8, label="gross sliding, beta = x - 1")
-ax.axvspan(0.1, 1.0, color="0.93", lw=0)
-ax.set_xscale("log")
-ax.set_xlabel("x = 3.5 mu (1 + e) vn / |v_c0|")
-ax.set_ylabel("beta = -v_c' / v_c0")
-ax.set_title("Test 6: Al sphere on a plane, e = 0.5, mu = 0.4 (shaded: sliding)", fontsize=9)
-ax.legend(fontsize=6)
-ax = axes[1]
-for form, color in FORMS:
-    p = series(tp, "sphere_in_plane", form, "test5_spin")
-    ax.plot([x for x, _, _ in p], [y for _, y, _ in p], "o-", mfc="none", color=color, ms=5, lw=0.6, label=f"grainlab {form.replace('_', ' ')}")
-p = series(tp, "sphere_in_plane", "total_displacement", "test5_spin")
-ax.plot([x for x, _, _ in p], [c for _, _, c in p], "k-", lw=1.2, label="Chung & Ooi (2011), steel (Kratos' digitisation)")
-ax.set_xlabel("tan(incident angle) / mu")
-ax.set_ylabel("rebound spin r w' / (mu vn)")
-ax.set_title("Test 5: steel sphere on a plane, e = 1, mu = 0.3", fontsize=9)
-ax.legend(fontsize=6)
+PANELS = [
+    (axes[0], "test6_beta", " (clamped damping)", "Chung & Ooi (2011), test 6 (Kratos' digitisation)", "x = 3.5 mu (1 + e) vn / |v_c0|", "beta = -v_c' / v_c0", "Test 6: Al sphere on a plane, e = 0.5, mu = 0.4 (shaded: sliding)"),
+    (axes[1], "test5_spin", "", "Chung & Ooi (2011), steel (Kratos' digitisation)", "tan(incident angle) / mu", "rebound spin r w' / (mu vn)", "Test 5: steel sphere on a plane, e = 1, mu = 0.3"),
+]
+for ax, q, note, paper_label, xlabel, ylabel, title in PANELS:
+    for form, color in FORMS:
+        p = series(tp, "sphere_in_plane", form, q)
+        ax.plot([x for x, _, _ in p], [y for _, y, _ in p], "o-", mfc="none", color=color, ms=5, lw=0.6, label=f"grainlab {form.replace('_', ' ')}{note}")
+    p = series(tp, "sphere_in_plane", "total_displacement", q)
+    ax.plot([x for x, _, _ in p], [c for _, _, c in p], "k-", lw=1.2, label=paper_label)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.set_title(title, fontsize=9)
+axes[0].plot([0.15, 1.0], [-0.85, 0.0], "k:", lw=0.8, label="gross sliding, beta = x - 1")
+axes[0].axvspan(0.1, 1.0, color="0.93", lw=0)
+axes[0].set_xscale("log")
+for ax in axes:
+    ax.legend(fontsize=6)
 fig.tight_layout()
 fig.savefig(os.path.join(OUT, "paper.png"), dpi=110)
 

@@ -105,6 +105,15 @@ macro_rules! displacement_history {
     };
 }
 
+/// One step of a total displacement as LIGGGHTS keeps it: `xi += vt dt`, then projected
+/// onto the current tangent line (the part along the normal `n` removed).
+#[inline(always)]
+fn advance_on_tangent<R: Real>(xi: &mut Vector2<R>, inp: &TangentialInput<R>) {
+    *xi += inp.vt * inp.dt;
+    let along_n = xi.dot(&inp.n);
+    *xi -= inp.n * along_n;
+}
+
 /// LIGGGHTS `tangential history`: a total tangential displacement `xi`, advanced by
 /// `vt dt` and projected onto the current tangent line each step; `Ft = -kt xi - gt vt`
 /// while sticking. When `|kt xi| > mu |Fn|` the contact slides: the force is the
@@ -118,10 +127,7 @@ impl Tangential for TotalDisplacement {
     displacement_history!();
     #[inline(always)]
     fn force<R: Real>(xi: &mut Vector2<R>, inp: &TangentialInput<R>) -> TangentialForce<R> {
-        let n = inp.n;
-        *xi += inp.vt * inp.dt;
-        let along_n = xi.dot(&n);
-        *xi -= n * along_n;
+        advance_on_tangent(xi, inp);
         let elastic = *xi * -inp.kt;
         let f_el = elastic.norm();
         // cap >= 0, so a sliding contact has f_el > 0.
@@ -276,10 +282,7 @@ impl Tangential for TotalForceCapSpringKept {
     displacement_history!();
     #[inline(always)]
     fn force<R: Real>(xi: &mut Vector2<R>, inp: &TangentialInput<R>) -> TangentialForce<R> {
-        let n = inp.n;
-        *xi += inp.vt * inp.dt;
-        let along_n = xi.dot(&n);
-        *xi -= n * along_n;
+        advance_on_tangent(xi, inp);
         let elastic = *xi * -inp.kt;
         let damping = inp.vt * -inp.gt;
         let trial = elastic + damping;
