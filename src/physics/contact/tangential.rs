@@ -271,6 +271,9 @@ impl Tangential for TotalForceCap {
 /// sticking). In gross sliding the friction impulse is mu times the normal impulse to
 /// rounding, under damped Hertz too (tests/chung_ooi.rs, tests 4, 6 and 8).
 ///
+/// Kratos increments its elastic force instead, and keeps a spring over the cap where a
+/// larger dashpot opposes it; here the spring never holds more than the cap.
+///
 /// The split for the energy ledger: elastic `-kt xi`, viscous the rest of the force
 /// (against the slip: it dissipates); friction takes what a slip removes from the spring.
 #[derive(Clone, Copy, Debug, Default)]
