@@ -109,9 +109,10 @@ impl Drop for Rows {
     }
 }
 
-/// The four frictional formulations: LIGGGHTS', YADE's, LAMMPS' (the cap on the total
-/// tangential force, issue 32) and the cap on the total with the spring kept (Kratos' rule).
-const FORMS: [TangentialSpec; 4] = [TangentialSpec::TotalDisplacement, TangentialSpec::IncrementalForce, TangentialSpec::TotalForceCap, TangentialSpec::TotalForceCapSpringKept];
+/// The five frictional formulations: LIGGGHTS', YADE's, LAMMPS' (the cap on the total
+/// tangential force, issue 32), the cap on the total with the spring kept (Kratos' rule)
+/// and Mindlin-Deresiewicz micro-slip.
+const FORMS: [TangentialSpec; 5] = [TangentialSpec::TotalDisplacement, TangentialSpec::IncrementalForce, TangentialSpec::TotalForceCap, TangentialSpec::TotalForceCapSpringKept, TangentialSpec::MindlinDeresiewicz];
 
 fn form_name(form: TangentialSpec) -> &'static str {
     form.name()
@@ -234,9 +235,17 @@ fn test_3_under_the_clamp_the_clamped_damping_returns_the_input_restitution() {
 /// thousands of steps' sums (measured: 1e-13).
 fn assert_gross_sliding(s: &Scene, imp: &ImpactSummary, kappa: f64, mu: f64, what: &str) {
     let (dvt, dw_r, closed, closed_w) = gross_sliding(s, imp, kappa, mu);
-    assert!(rel(dvt, closed) < 1e-9, "{what}: dvt {dvt} vs -mu dvn {closed}");
-    assert!(rel(dw_r, closed_w) < 1e-9, "{what}: r dw {dw_r} vs -kappa mu dvn {closed_w}");
+    let bound = if s.model.tangential == TangentialSpec::MindlinDeresiewicz { MICROSLIP_GROSS } else { 1e-9 };
+    assert!(rel(dvt, closed) < bound, "{what}: dvt {dvt} vs -mu dvn {closed}");
+    assert!(rel(dw_r, closed_w) < bound, "{what}: r dw {dw_r} vs -kappa mu dvn {closed_w}");
 }
+
+/// How close micro-slip comes to the gross-sliding identities: to rounding where the
+/// contact slides clear of the threshold (measured 1e-13 and below), 3.9e-7 for the
+/// sphere of test 5 at 65 degrees, 2% above it: there the contact point's slip comes to
+/// rest as the grain leaves, and the springs that still hold less than their share of mu
+/// |Fn| (micro-slip's stick zone) carry less than mu |Fn| for those steps.
+const MICROSLIP_GROSS: f64 = 1e-6;
 
 /// Grain 0's tangential velocity change and r times its spin change, and what gross
 /// sliding gives for them: `(dvt, r dw, -mu dvn sign, -kappa mu dvn sign)`.
@@ -358,6 +367,11 @@ fn test_6_varying_initial_spin() {
                     // identities hold to rounding under damped Hertz (measured: 2.2e-16
                     // sphere, 1.6e-15 disk).
                     assert_gross_sliding(&s, &imp, kappa, 0.4, &what);
+                } else if form == TangentialSpec::MindlinDeresiewicz {
+                    // Micro-slip caps the total as the spring-kept cap: every spring at its
+                    // share of mu |Fn| in gross sliding (measured: 2.2e-16 sphere, 1.6e-15
+                    // disk).
+                    assert!(excess.abs() < 1e-9, "{what}: friction impulse {excess:e} from mu J");
                 } else if form == TangentialSpec::TotalForceCap {
                     // LAMMPS' law caps the total, so the impulse never exceeds mu J (the
                     // clamp holds Fn >= 0); but it keeps the dashpot's force in the spring
@@ -438,6 +452,10 @@ fn test_8_a_small_sphere_on_a_larger_denser_one() {
                     // the line of centres (measured -2.5e-4 sphere, -4.6e-5 disk), as the
                     // undamped contact below.
                     assert!(excess.abs() < 1e-3, "{what}: friction impulse {excess:e} from mu J");
+                } else if form == TangentialSpec::MindlinDeresiewicz {
+                    // Micro-slip: as the spring-kept cap (measured -2.5e-4 sphere, -4.6e-5
+                    // disk).
+                    assert!(excess.abs() < 1e-3, "{what}: friction impulse {excess:e} from mu J");
                 } else if form == TangentialSpec::TotalForceCap {
                     // LAMMPS' law: at most mu J (within the 1e-3 of the turning line of
                     // centres), short of it as in test 6 (measured 9.2%).
@@ -501,21 +519,26 @@ fn test_5_spin(x: f64, form: TangentialSpec) -> f64 {
 }
 
 #[test]
-fn tests_5_and_6_meet_the_papers_sliding_curves_within_kratos_tolerance() {
-    // The paper's curves (Kratos' digitisation) where the contact slides, measured as
-    // Kratos measures them and against its bounds: test 6's first six points (x = 0.19 to
-    // 1.21, beta; 3%), test 5's finite-element points at x = 7 to 19 (the spin; 2%).
-    // Test 6 with the variant that models what the paper assumes: the realised e is the
-    // input 0.5 (the clamped damping) and the friction impulse mu J (the spring-kept cap):
-    // measured 2.6%: 1.1 from the sixth point (x = 1.21, past the sliding threshold, where
-    // the paper's micro-slip acts) and 1.5 from the five sliding ones, which is the
-    // digitisation's own scatter (the closed form x - 1 is 1.5% from them, and these runs
-    // within 1.5e-4 of it). The other formulations miss it (15-37%:
-    // the friction impulse is not mu J under damped Hertz), the control. Test 5 is undamped
-    // (e = 1): every formulation slides alike there (0.71%). The whole diagrams, sticking
-    // regime included, are written for the plots of docs/benchmarks.md (issue 32: the
-    // paper's sticking curves include Mindlin-Deresiewicz micro-slip, which no formulation
-    // here models).
+fn tests_5_and_6_meet_the_papers_curves_within_kratos_tolerance() {
+    // The paper's curves (Kratos' digitisation), measured as Kratos measures them and
+    // against its bounds: test 6's first six points (x = 0.19 to 1.21, beta; 3%), where
+    // the contact slides, and test 5's finite-element points (the spin; 2%).
+    // Test 6 with the variants that model what the paper assumes: the realised e is the
+    // input 0.5 (the clamped damping) and the friction impulse mu J (the spring-kept cap,
+    // micro-slip): measured 2.6% and 1.7%. Of the spring-kept cap's, 1.1 points come from
+    // the sixth point (x = 1.21, past the sliding threshold, where the paper's micro-slip
+    // acts: micro-slip's own gap there is 0.4 points) and 1.5 from the five sliding ones,
+    // the digitisation's own scatter (the closed form x - 1 is 1.5% from them, and these
+    // runs within 1.5e-4 of it). The other formulations miss it (15-37%: the friction
+    // impulse is not mu J under damped Hertz), the control.
+    // Test 5 is undamped (e = 1): every formulation slides alike at x = 7 to 19 (0.71%);
+    // over the whole diagram, sticking regime included, micro-slip meets the
+    // finite-element curve (measured 1.25%; 1.63% over the 13 points at x <= 5.7, where
+    // the contact sticks for part of the impact), the no-slip springs do not (13-15% over
+    // those points: their contact point keeps 0.96 of its slip velocity at small
+    // angles, the finite element's and micro-slip's about 0.2).
+    // The whole diagrams are written for the plots of docs/benchmarks.md; test 6's
+    // sticking regime is not asserted (39-66% for every formulation: docs/benchmarks.md).
     let mut rows = Rows::new("paper");
     let t6 = paper("test6_beta.csv", "test6");
     for form in FORMS {
@@ -524,7 +547,7 @@ fn tests_5_and_6_meet_the_papers_sliding_curves_within_kratos_tolerance() {
             rows.add(GrainShape::SphereInPlane, form_name(form), x, "test6_beta", b, Some(p));
         }
         let err6 = kratos_error(&ours[..6], &t6[..6]);
-        if form == TangentialSpec::TotalForceCapSpringKept {
+        if matches!(form, TangentialSpec::TotalForceCapSpringKept | TangentialSpec::MindlinDeresiewicz) {
             assert!(err6 < 0.03, "test 6, {form:?}: {err6:e} of the paper's curve (Kratos' bound 3%)");
         } else {
             assert!(err6 > 0.1, "test 6, {form:?}: {err6:e}, the control: the friction impulse is not mu J here");
@@ -536,6 +559,19 @@ fn tests_5_and_6_meet_the_papers_sliding_curves_within_kratos_tolerance() {
         let ours: Vec<f64> = sliding.iter().map(|&(x, _)| test_5_spin(x, form)).collect();
         let err5 = kratos_error(&ours, sliding);
         assert!(err5 < 0.02, "test 5, {form:?}: {err5:e} of the paper's curve (Kratos' bound 2%)");
+        // The whole diagram, sticking regime included: micro-slip models what the
+        // finite-element reference computes (elastic spheres with Coulomb friction over
+        // the contact area); the no-slip springs are the control.
+        let whole: Vec<f64> = fem.iter().map(|&(x, _)| test_5_spin(x, form)).collect();
+        let (err_whole, err_stick) = (kratos_error(&whole, &fem), kratos_error(&whole[..13], &fem[..13]));
+        if form == TangentialSpec::MindlinDeresiewicz {
+            assert!(err_whole < 0.02 && err_stick < 0.02, "test 5 whole diagram, micro-slip: {err_whole:e}, sticking part {err_stick:e} (Kratos' bound 2%)");
+        } else {
+            assert!(err_stick > 0.1, "test 5 sticking part, {form:?}: {err_stick:e}, the control: no-slip springs miss it");
+        }
+        for (&(x, p), &b) in fem.iter().zip(&whole) {
+            rows.add(GrainShape::SphereInPlane, form_name(form), x, "test5_fem_spin", b, Some(p));
+        }
         for &(x, p) in &paper("test5_spin.csv", "steel") {
             rows.add(GrainShape::SphereInPlane, form_name(form), x, "test5_spin", test_5_spin(x, form), Some(p));
         }

@@ -121,11 +121,11 @@ fn a_sliding_oblique_impact_obeys_coulomb_exactly() {
     // 1). With the clamp (Fn >= 0) every step's tangential impulse is mu times its normal
     // impulse, so the tangential velocity change is mu times the normal one and the spin
     // is m r dv_t / I, for LIGGGHTS' and YADE's formulations and for the cap on the
-    // total with the spring kept (whose total force is mu |Fn| while sliding), to
-    // round-off.
+    // total with the spring kept (whose total force is mu |Fn| while sliding), and for
+    // micro-slip (every spring at its share of mu |Fn|), to round-off.
     use grainlab::scene::TangentialSpec;
     use grainlab::scene::builtin::oblique;
-    for t in [TangentialSpec::TotalDisplacement, TangentialSpec::IncrementalForce, TangentialSpec::TotalForceCapSpringKept] {
+    for t in [TangentialSpec::TotalDisplacement, TangentialSpec::IncrementalForce, TangentialSpec::TotalForceCapSpringKept, TangentialSpec::MindlinDeresiewicz] {
         let mut g = glass(0.9);
         g.friction = 0.1;
         let v = 1.0;

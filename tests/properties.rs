@@ -162,7 +162,7 @@ proptest! {
     #[test]
     fn four_lanes_give_each_contact_its_own_bits(c0 in contact(), c1 in contact(), c2 in contact(), c3 in contact(), clamp in any::<bool>(), lever in 0usize..5) {
         use grainlab::physics::contact::LeverArm;
-        use grainlab::physics::contact::tangential::{IncrementalForce, IncrementalState, TotalDisplacement, TotalForceCap, TotalForceCapSpringKept};
+        use grainlab::physics::contact::tangential::{IncrementalForce, IncrementalState, MICROSLIP_SPRINGS, MicroSlip, MicroSlipState, TotalDisplacement, TotalForceCap, TotalForceCapSpringKept};
         use grainlab::physics::contact::damping::{LinearRestitution, TsujiFit, Viscoelastic};
         use grainlab::physics::contact::normal::{Hertz, Hooke};
         use grainlab::physics::contact::rolling::{Cdt, Epsd2, RollingMemory, Sds};
@@ -180,6 +180,17 @@ proptest! {
         // The cap on the total with the spring kept: sticking, sliding with the spring
         // below the cap (the dashpot takes the rest) and above it, lane by lane.
         lanes_match_alone::<Hertz, Viscoelastic, TotalForceCapSpringKept, NoRolling>(Hertz, NoRolling, &cs, clamp, lever, |c| Vec2::new(c[5], c[6]), v, |_| (), |_| vec![], |_| (), |_| vec![])?;
+        // Micro-slip: beds from far finer to far coarser than the contact's radius (kt
+        // from about 1e3 to 1e8 N/m here), so that lanes regrid differently (merging,
+        // splitting, starting anew, or not at all), springs sticking and slipping.
+        let micro = |c: &[f64; 9]| MicroSlipState {
+            u: std::array::from_fn(|i| c[5] * (0.37 * i as f64 + c[6] * 1e5).sin()),
+            cell: 10f64.powf(1.0 + c[7]),
+            kt: 10f64.powf(2.0 + 6.0 * c[8]),
+        };
+        let micro_bits = |h: &MicroSlipState| h.u.iter().chain([&h.cell, &h.kt]).map(|x| x.to_bits()).collect::<Vec<u64>>();
+        assert_eq!(MICROSLIP_SPRINGS, micro(&cs[0]).u.len());
+        lanes_match_alone::<Hertz, Viscoelastic, MicroSlip, NoRolling>(Hertz, NoRolling, &cs, clamp, lever, micro, micro_bits, |_| (), |_| vec![], |_| (), |_| vec![])?;
         // The linear spring, derived per pair (a fifth root lane by lane) and given.
         for spring in [Hooke::Derived { vc: 0.8 }, Hooke::Given { kn: 3e5, kt: 2e5 }] {
             lanes_match_alone::<Hooke, LinearRestitution, TotalDisplacement, NoRolling>(spring, NoRolling, &cs, clamp, lever, |c| Vec2::new(c[5], c[6]), v, |_| (), |_| vec![], |_| (), |_| vec![])?;

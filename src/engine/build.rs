@@ -398,6 +398,8 @@ pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<B
         (None, TangentialSpec::TotalForceCap, true) => parts.assemble(HertzForceCapElastic::new(options, Hertz))?,
         (None, TangentialSpec::TotalForceCapSpringKept, false) => parts.assemble(HertzSpringKept::new(options, Hertz))?,
         (None, TangentialSpec::TotalForceCapSpringKept, true) => parts.assemble(HertzSpringKeptElastic::new(options, Hertz))?,
+        (None, TangentialSpec::MindlinDeresiewicz, false) => parts.assemble(HertzMicroSlip::new(options, Hertz))?,
+        (None, TangentialSpec::MindlinDeresiewicz, true) => parts.assemble(HertzMicroSlipElastic::new(options, Hertz))?,
         (None, TangentialSpec::IncrementalForce, false) => parts.assemble(YadeMindlin::new(options, Hertz))?,
         (None, TangentialSpec::IncrementalForce, true) => parts.assemble(YadeMindlinElastic::new(options, Hertz))?,
         (Some(h), TangentialSpec::Frictionless, false) => parts.assemble(HookeFrictionless::new(options, h))?,
@@ -408,6 +410,8 @@ pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<B
         (Some(h), TangentialSpec::TotalForceCap, true) => parts.assemble(HookeForceCapElastic::new(options, h))?,
         (Some(h), TangentialSpec::TotalForceCapSpringKept, false) => parts.assemble(HookeSpringKept::new(options, h))?,
         (Some(h), TangentialSpec::TotalForceCapSpringKept, true) => parts.assemble(HookeSpringKeptElastic::new(options, h))?,
+        // Validation refuses it (micro-slip spreads over the Hertz radius).
+        (Some(_), TangentialSpec::MindlinDeresiewicz, _) => return Err(Error::Invalid { field: "model.tangential".into(), value: "\"mindlin_deresiewicz\"".into(), allowed: "another formulation with a linear spring".into() }),
         (Some(h), TangentialSpec::IncrementalForce, false) => parts.assemble(HookeIncremental::new(options, h))?,
         (Some(h), TangentialSpec::IncrementalForce, true) => parts.assemble(HookeIncrementalElastic::new(options, h))?,
     };

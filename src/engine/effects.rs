@@ -99,6 +99,7 @@ impl Effects {
             TangentialSpec::TotalDisplacement => "total displacement (LIGGGHTS' history)",
             TangentialSpec::TotalForceCap => "total displacement, cap on the total force (LAMMPS' history)",
             TangentialSpec::TotalForceCapSpringKept => "total displacement, cap on the total force with the spring kept (Kratos' rule)",
+            TangentialSpec::MindlinDeresiewicz => "Mindlin-Deresiewicz micro-slip (a bed of springs across the Hertz radius)",
             TangentialSpec::IncrementalForce => "incremental force (YADE's)",
             TangentialSpec::Frictionless => "none",
         };
@@ -111,6 +112,7 @@ impl Effects {
             TangentialSpec::IncrementalForce => "incremental force (YADE's)",
             TangentialSpec::TotalForceCap => "total force cap (LAMMPS')",
             TangentialSpec::TotalForceCapSpringKept => "total force cap, spring kept (Kratos')",
+            TangentialSpec::MindlinDeresiewicz => "Mindlin-Deresiewicz micro-slip",
             _ => "frictionless (no tangential, no spin stage)",
         };
         push("friction (tangential force)", friction, friction_why, Some(measured));

@@ -321,6 +321,13 @@ pub enum TangentialSpec {
     /// (docs/model.md). No reference code has it: exports write the nearest law with a
     /// `# Differs:` line.
     TotalForceCapSpringKept,
+    /// Mindlin-Deresiewicz micro-slip (Hertz only): the contact is a bed of springs
+    /// across its radius, each holding its share of the Hertz pressure times mu, so slip
+    /// spreads in from the edge as the tangential load grows, under any history of normal
+    /// and tangential load (Popov and Heß's method of dimensionality reduction, exact for
+    /// these contacts; docs/model.md). Dashpot and cap as the spring-kept cap. No
+    /// reference code has micro-slip: exports refuse it.
+    MindlinDeresiewicz,
     /// YADE `Law2_ScGeom_MindlinPhys_Mindlin`.
     IncrementalForce,
     /// No tangential force (and no spin).
@@ -334,6 +341,7 @@ impl TangentialSpec {
             TangentialSpec::TotalDisplacement => "total_displacement",
             TangentialSpec::TotalForceCap => "total_force_cap",
             TangentialSpec::TotalForceCapSpringKept => "total_force_cap_spring_kept",
+            TangentialSpec::MindlinDeresiewicz => "mindlin_deresiewicz",
             TangentialSpec::IncrementalForce => "incremental_force",
             TangentialSpec::Frictionless => "frictionless",
         }

@@ -164,6 +164,10 @@ impl Scene {
             }
         }
         let tsuji = self.model.damping == DampingSpec::Tsuji;
+        // Micro-slip's bed of springs spans the Hertz contact radius (kt = 8 G* a).
+        if self.model.tangential == TangentialSpec::MindlinDeresiewicz && !self.model.normal.is_hertz() {
+            check(false, "model", "tangential", "\"mindlin_deresiewicz\"", &format!("another formulation with a linear spring (micro-slip spreads over the Hertz contact radius, kt = 8 G* a; compiled: {})", crate::physics::contact::model::COMPILED))?;
+        }
         // The clamped restitution damping returns e under the clamp, which it needs, and
         // has no finite damping for e = 0.
         if self.model.damping == DampingSpec::ClampedRestitution {
@@ -172,7 +176,7 @@ impl Scene {
                 check(false, &format!("materials[{k}]"), "restitution", 0.0, "(0, 1] with model.damping = clamped_restitution (under the clamp e -> 0 needs infinite damping; without the clamp, the default damping's e = 0 keeps the grains together)")?;
             }
         }
-        if tsuji && matches!(self.model.tangential, TangentialSpec::IncrementalForce | TangentialSpec::TotalForceCapSpringKept) {
+        if tsuji && matches!(self.model.tangential, TangentialSpec::IncrementalForce | TangentialSpec::TotalForceCapSpringKept | TangentialSpec::MindlinDeresiewicz) {
             check(false, "model", "damping", "tsuji", &format!("\"restitution\" with model.tangential = {} (compiled: {})", self.model.tangential.name(), crate::physics::contact::model::COMPILED))?;
         }
         // DMT cohesion is compiled with the restitution damping, frictionless or with the

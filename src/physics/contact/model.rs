@@ -13,7 +13,7 @@ use super::cohesion::{Cohesion, Dmt, NoCohesion};
 use super::rolling::{Cdt, Epsd2, InLanes, NoRolling, Rolling, RollingEnergy, RollingInput, Sds};
 use super::damping::{Damping, LinearRestitution, TsujiFit, Undamped, Viscoelastic};
 use super::normal::{Hertz, Hooke, Normal};
-use super::tangential::{Frictionless, IncrementalForce, Tangential, TangentialForce, TangentialInput, TotalDisplacement, TotalForceCap, TotalForceCapSpringKept};
+use super::tangential::{Frictionless, IncrementalForce, Tangential, TangentialForce, TangentialInput, TotalDisplacement, TotalForceCap, TotalForceCapSpringKept, MicroSlip};
 use crate::physics::dim::Vec2;
 use crate::physics::energy::{EnergyLedger, EnergySums};
 use crate::physics::lanes::{Real, k, pick};
@@ -559,6 +559,12 @@ pub type HertzSpringKeptElastic = ContactModel<Hertz, Undamped, TotalForceCapSpr
 pub type HookeSpringKept = ContactModel<Hooke, LinearRestitution, TotalForceCapSpringKept>;
 pub type HookeSpringKeptElastic = ContactModel<Hooke, Undamped, TotalForceCapSpringKept>;
 
+/// Mindlin-Deresiewicz micro-slip (`model.tangential = "mindlin_deresiewicz"`), Hertz
+/// only (its bed of springs spans the Hertz radius, `kt = 8 G* a`), with the restitution
+/// damping or none.
+pub type HertzMicroSlip = ContactModel<Hertz, Viscoelastic, MicroSlip>;
+pub type HertzMicroSlipElastic = ContactModel<Hertz, Undamped, MicroSlip>;
+
 /// LAMMPS `pair granular ... damping tsuji` (`model.damping = "tsuji"`), either normal
 /// law, frictionless or with the total-displacement history.
 pub type HertzTsujiFrictionless = ContactModel<Hertz, TsujiFit, Frictionless>;
@@ -585,4 +591,4 @@ pub type HookeHistoryEpsd2 = ContactModel<Hooke, LinearRestitution, TotalDisplac
 pub type HookeHistorySds = ContactModel<Hooke, LinearRestitution, TotalDisplacement, NoCohesion, Sds>;
 
 /// The names of the compiled combinations, for a refusal.
-pub const COMPILED: &str = "normal hertz or hooke (hooke_stiffness), each with damping (beta(e); the linear spring's constant-restitution form) or none (every e = 1), and tangential total_displacement, total_force_cap, total_force_cap_spring_kept, incremental_force or frictionless; damping tsuji with either normal law, total_displacement, total_force_cap or frictionless; cohesion (work_of_adhesion > 0) with either normal law, the restitution damping, total_displacement or frictionless, without limit_force; rolling (cdt, epsd2, sds) with either normal law, the restitution damping and total_displacement, without cohesion";
+pub const COMPILED: &str = "normal hertz or hooke (hooke_stiffness), each with damping (beta(e); the linear spring's constant-restitution form) or none (every e = 1), and tangential total_displacement, total_force_cap, total_force_cap_spring_kept, incremental_force or frictionless; mindlin_deresiewicz with hertz, its damping or none; damping tsuji with either normal law, total_displacement, total_force_cap or frictionless; cohesion (work_of_adhesion > 0) with either normal law, the restitution damping, total_displacement or frictionless, without limit_force; rolling (cdt, epsd2, sds) with either normal law, the restitution damping and total_displacement, without cohesion";

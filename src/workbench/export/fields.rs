@@ -41,6 +41,9 @@ pub struct Decision {
     pub one_value: Option<&'static str>,
 }
 
+/// Why no code's deck can express `model.tangential = "mindlin_deresiewicz"`.
+const MICROSLIP_REFUSED: &str = "\"mindlin_deresiewicz\": no reference code has micro-slip (LIGGGHTS', LAMMPS' and YADE's Mindlin laws are no-slip springs, and YADE's Law2_ScGeom_MindlinPhys_MindlinDeresiewitz computes no shear force); the nearest law's oblique impacts differ several-fold at small angles";
+
 const NONE: Decision = Decision { written: None, refused: None, differs: None, outside: None, one_value: None };
 
 const fn written(to: &'static str) -> Decision {
@@ -325,13 +328,16 @@ pub const FIELDS: &[Field] = &[
     each(
         "model.tangential",
         written("total_displacement: `pair_style gran model hertz tangential history`; frictionless: coefficientFriction 0 (Ft = 0) and `nve`")
-            .or_differs("incremental_force, total_force_cap, total_force_cap_spring_kept", "LIGGGHTS has only the total-displacement history, which caps the elastic force alone; head-on impacts agree, oblique ones differ (incremental_force: rebound spin up to 2x; total_force_cap, total_force_cap_spring_kept: frictional contacts with damping)"),
+            .or_differs("incremental_force, total_force_cap, total_force_cap_spring_kept", "LIGGGHTS has only the total-displacement history, which caps the elastic force alone; head-on impacts agree, oblique ones differ (incremental_force: rebound spin up to 2x; total_force_cap, total_force_cap_spring_kept: frictional contacts with damping)")
+            .or_refused(MICROSLIP_REFUSED),
         written("incremental_force: Law2_ScGeom_MindlinPhys_Mindlin; frictionless: frictionAngle 0 (Ft = 0)")
-            .or_differs("total_displacement, total_force_cap, total_force_cap_spring_kept", "YADE's Mindlin law adds force increments; head-on impacts agree, oblique ones differ (rebound spin up to 2x)"),
+            .or_differs("total_displacement, total_force_cap, total_force_cap_spring_kept", "YADE's Mindlin law adds force increments; head-on impacts agree, oblique ones differ (rebound spin up to 2x)")
+            .or_refused(MICROSLIP_REFUSED),
     )
     .in_lammps(
         written("total_force_cap (LAMMPS' own law) and total_displacement: `tangential mindlin` (Hertz) or `tangential linear_history` (linear spring), a total tangential displacement; frictionless: MU 0 (Ft = 0) and `nve`")
-            .or_differs("total_displacement, total_force_cap_spring_kept, incremental_force", TANGENTIAL_M),
+            .or_differs("total_displacement, total_force_cap_spring_kept, incremental_force", TANGENTIAL_M)
+            .or_refused(MICROSLIP_REFUSED),
     ),
     each(
         "model.limit_force",

@@ -60,6 +60,9 @@ pub fn export_with(scene: &Scene, code: Code, dir: &Path, bench: bool) -> Result
 /// What [`export_with`] writes, as (file name, text), without writing it.
 pub fn export_files(scene: &Scene, code: Code, bench: bool, limits: &crate::scene::limits::Limits) -> Result<Vec<(&'static str, String)>, Error> {
     let mut ex = prepare(scene, code, limits)?;
+    if scene.model.tangential == crate::scene::TangentialSpec::MindlinDeresiewicz {
+        return Err(fields::refuse(code, "model.tangential", "\"mindlin_deresiewicz\"", ""));
+    }
     ex.bench = bench;
     let b = bounds(&ex.built, scene.duration);
     let deck = match code {
