@@ -93,6 +93,10 @@ fn bases(dir: &Path) -> Vec<Value> {
     pair["model"]["limit_force"] = true.into();
     pair["gravity"] = json!([0.0, -9.81]);
     out.push(pair);
+    // Micro-slip's beds of springs, in the oblique impact.
+    let mut micro = json(&builtin::builtin("oblique").unwrap());
+    micro["model"]["tangential"] = "mindlin_deresiewicz".into();
+    out.push(micro);
     let mut flat = json(&shear);
     flat["walls"]["bottom"]["surface"] = "flat".into();
     flat["walls"]["top"]["surface"] = "flat".into();

@@ -51,7 +51,7 @@ fn tsuji_damping_realises_the_restitution_of_its_beta() {
 }
 
 #[test]
-fn tsuji_damping_is_refused_with_the_incremental_force_the_spring_kept_cap_and_by_liggghts_and_yade() {
+fn tsuji_damping_is_refused_with_the_incremental_force_the_spring_kept_cap_micro_slip_and_by_liggghts_and_yade() {
     let mut s = grainlab::scene::builtin::builtin("collision").unwrap();
     s.model.damping = DampingSpec::Tsuji;
     for code in [grainlab::workbench::export::Code::Liggghts, grainlab::workbench::export::Code::Yade] {
@@ -59,10 +59,26 @@ fn tsuji_damping_is_refused_with_the_incremental_force_the_spring_kept_cap_and_b
         assert!(e.contains(&format!("export to {}: model.damping = \"tsuji\" cannot be expressed", code.name())), "{e}");
     }
     assert!(grainlab::workbench::export::export_files(&s, grainlab::workbench::export::Code::Lammps, false, &Default::default()).is_ok());
-    for form in [TangentialSpec::IncrementalForce, TangentialSpec::TotalForceCapSpringKept] {
+    for form in [TangentialSpec::IncrementalForce, TangentialSpec::TotalForceCapSpringKept, TangentialSpec::MindlinDeresiewicz] {
         s.model.tangential = form;
         let e = grainlab::Scene::from_json(&s.to_json()).expect_err("not compiled").to_string();
         assert!(e.contains("model.damping = tsuji") && e.contains(form.name()) && e.contains("compiled:"), "{e}");
     }
 }
 
+
+#[test]
+fn micro_slip_is_refused_with_the_linear_spring_and_by_every_export() {
+    // Micro-slip's bed of springs spans the Hertz contact radius (kt = 8 G* a): refused by
+    // name with a linear spring. No reference code has micro-slip: each export refuses it
+    // by name, rather than write a deck whose oblique impacts differ several-fold.
+    let mut s = grainlab::scene::builtin::builtin("oblique").unwrap();
+    s.model.tangential = TangentialSpec::MindlinDeresiewicz;
+    for code in [grainlab::workbench::export::Code::Liggghts, grainlab::workbench::export::Code::Yade, grainlab::workbench::export::Code::Lammps] {
+        let e = grainlab::workbench::export::export_files(&s, code, false, &Default::default()).expect_err("no micro-slip there").to_string();
+        assert!(e.contains(&format!("export to {}: model.tangential = \"mindlin_deresiewicz\" cannot be expressed", code.name())), "{e}");
+    }
+    s.model.normal = grainlab::scene::NormalLaw::Hooke { characteristic_velocity: 1.0 };
+    let e = grainlab::Scene::from_json(&s.to_json()).expect_err("Hertz only").to_string();
+    assert!(e.contains("model.tangential = \"mindlin_deresiewicz\"") && e.contains("Hertz contact radius"), "{e}");
+}

@@ -151,7 +151,8 @@ pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<B
             }
         }
     }
-    let mut estimate = MemoryEstimate { grains: (count, count_field, count_value), wall_grains, materials: mats.len() as u64, ..Default::default() };
+    let microslip = scene.model.tangential == TangentialSpec::MindlinDeresiewicz;
+    let mut estimate = MemoryEstimate { grains: (count, count_field, count_value), wall_grains, materials: mats.len() as u64, microslip, ..Default::default() };
     limits.check(&estimate)?;
 
     let mut p = Particles::default();
