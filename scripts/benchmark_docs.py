@@ -18,7 +18,7 @@ def rows(test):
 
 
 SHAPES = [("sphere_in_plane", "sphere in the plane", "o"), ("disk", "disk", "s")]
-FORMS = [("total_displacement", "C0"), ("incremental_force", "C3"), ("total_force_cap", "C2"), ("total_force_cap_spring_kept", "C4")]
+FORMS = [("total_displacement", "C0"), ("incremental_force", "C3"), ("total_force_cap", "C2"), ("total_force_cap_spring_kept", "C4"), ("mindlin_deresiewicz", "C1")]
 
 
 def series(rs, shape, form, quantity):
@@ -106,12 +106,14 @@ fig.tight_layout()
 fig.savefig(os.path.join(OUT, "test_6.png"), dpi=110)
 
 # Against the paper's curves (tests/data/chung_ooi_paper, Kratos' digitisation): test 6's
-# beta against x, test 5's spin against tan(angle) / mu, every formulation.
-fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
+# beta against x, test 5's spin against tan(angle) / mu (the paper's theory for steel and
+# its finite-element reference), every formulation.
+fig, axes = plt.subplots(1, 3, figsize=(16, 4.2))
 tp = rows("paper")
 PANELS = [
     (axes[0], "test6_beta", " (clamped damping)", "Chung & Ooi (2011), test 6 (Kratos' digitisation)", "x = 3.5 mu (1 + e) vn / |v_c0|", "beta = -v_c' / v_c0", "Test 6: Al sphere on a plane, e = 0.5, mu = 0.4 (shaded: sliding)"),
-    (axes[1], "test5_spin", "", "Chung & Ooi (2011), steel (Kratos' digitisation)", "tan(incident angle) / mu", "rebound spin r w' / (mu vn)", "Test 5: steel sphere on a plane, e = 1, mu = 0.3"),
+    (axes[1], "test5_spin", "", "Chung & Ooi (2011), steel, theory (Kratos' digitisation)", "tan(incident angle) / mu", "rebound spin r w' / (mu vn)", "Test 5: steel sphere on a plane, e = 1, mu = 0.3"),
+    (axes[2], "test5_fem_spin", "", "Chung & Ooi (2011), finite elements (Kratos' digitisation)", "tan(incident angle) / mu", "rebound spin r w' / (mu vn)", "Test 5 against the finite-element reference"),
 ]
 for ax, q, note, paper_label, xlabel, ylabel, title in PANELS:
     for form, color in FORMS:

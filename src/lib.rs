@@ -10,7 +10,8 @@
 //!    compile time ([`physics::contact`]: a normal law, Hertz or the linear spring; a
 //!    damping form, the one that returns e or LAMMPS' Tsuji fit; a tangential
 //!    formulation, LIGGGHTS' total displacement, YADE's increments, LAMMPS' cap on the
-//!    total force or that cap with the spring kept (Kratos' rule); one monomorphized
+//!    total force, that cap with the spring kept (Kratos' rule), or Mindlin-Deresiewicz
+//!    micro-slip on a bed of springs across the contact; one monomorphized
 //!    kernel per named combination), written once over its number type to run one
 //!    contact or four in SIMD lanes with the same bits ([`physics::lanes`]); walls, flat
 //!    or rough, fixed or loaded ([`physics::walls`]), the periodic boundary in x

@@ -20,8 +20,10 @@ pub const BYTES_PER_GRAIN: u64 = 1024;
 /// Bytes per grain (free or glued to a wall) of micro-slip's beds of springs
 /// (`model.tangential = "mindlin_deresiewicz"`), on top of [`BYTES_PER_GRAIN`]: each
 /// listed pair keeps 66 f64 (528 bytes); measured 1080 bytes per grain more than the total
-/// displacement's in the shear cell at 20000 grains, and 2048 covers denser networks.
-pub const BYTES_PER_GRAIN_MICROSLIP: u64 = 2048;
+/// displacement's in the shear cell at 20000 grains and 2160 at 5000 (the pair lists'
+/// capacity doubles as they grow), and 6144 covers denser networks (the margin of
+/// [`BYTES_PER_GRAIN`] over its measured 392).
+pub const BYTES_PER_GRAIN_MICROSLIP: u64 = 6144;
 
 /// Bytes per entry of the materials' pair table (one `PairMaterial`, 7 f64).
 pub const BYTES_PER_MATERIAL_PAIR: u64 = 56;
@@ -289,6 +291,6 @@ mod tests {
         let m = MemoryEstimate { microslip: true, ..e };
         assert_eq!(m.bytes(), (1 << 20) * (BYTES_PER_GRAIN + BYTES_PER_GRAIN_MICROSLIP) + 10 * (BYTES_PER_GRAIN + BYTES_PER_GRAIN_MICROSLIP) + BYTES_PER_MATERIAL_PAIR + 400 * BYTES_PER_ROW);
         let msg = Limits::with_memory(2 << 30).check(&m).unwrap_err().to_string();
-        assert!(msg.contains("grains.pack.count = 1048576") && msg.contains("2.0 GiB for micro-slip's springs"), "{msg}");
+        assert!(msg.contains("grains.pack.count = 1048576") && msg.contains("6.0 GiB for micro-slip's springs"), "{msg}");
     }
 }
