@@ -534,7 +534,7 @@ fn tests_5_and_6_meet_the_papers_curves_within_kratos_tolerance() {
     // Test 5 is undamped (e = 1): every formulation slides alike at x = 7 to 19 (0.71%);
     // over the whole diagram, sticking regime included, micro-slip meets the
     // finite-element curve (measured 1.25%; 1.63% over the 13 points at x <= 5.7, where
-    // the contact sticks for part of the impact), the no-slip springs do not (13-15% over
+    // the contact sticks for part of the impact), the no-slip springs do not (12-13% over
     // those points: their contact point keeps 0.96 of its slip velocity at small
     // angles, the finite element's and micro-slip's about 0.2).
     // The whole diagrams are written for the plots of docs/benchmarks.md; test 6's
