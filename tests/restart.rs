@@ -148,10 +148,17 @@ fn a_run_resumes_more_than_once() {
 }
 
 /// Two beads head-on, stopped half-way through their contact: the contact's state, the
-/// impact observer's and its force-overlap curve carry across the stop.
+/// impact observer's and its force-overlap curve carry across the stop. Likewise an
+/// oblique impact under micro-slip, whose contact carries its bed of springs.
 #[test]
 fn an_impact_stopped_mid_contact_resumes_exactly() {
-    let scene = grainlab::scene::builtin::builtin("collision").unwrap();
+    stopped_mid_contact(grainlab::scene::builtin::builtin("collision").unwrap());
+    let mut oblique = grainlab::scene::builtin::builtin("oblique").unwrap();
+    oblique.model.tangential = grainlab::scene::TangentialSpec::MindlinDeresiewicz;
+    stopped_mid_contact(oblique);
+}
+
+fn stopped_mid_contact(scene: Scene) {
     let mut built = grainlab::build(&scene).unwrap();
     let e = built.engine.as_mut();
     while e.touching() == 0 {

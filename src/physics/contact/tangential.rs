@@ -343,8 +343,12 @@ impl<R: Real> Default for MicroSlipState<R> {
 /// A micro-slip contact's state as a checkpoint stores it: the same numbers.
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct MicroSlipSaved {
+    /// Each spring's tangential displacement, m ([`MicroSlipState::u`]; a checkpoint
+    /// with fewer is read with the rest 0, one with more with the extra dropped).
     pub u: Vec<f64>,
+    /// The width of one spring's cell as a stiffness, N/m.
     pub cell: f64,
+    /// The tangential stiffness at the previous step, N/m.
     pub kt: f64,
 }
 
