@@ -126,6 +126,19 @@ fn slip_to<R: Real>(xi: &mut Vector2<R>, kt: R, scale: R, slide: R::SimdBool) ->
     pick(slide, before - after, R::zero())
 }
 
+/// The dashpot's part of a tangential force whose *total* is capped (the spring-kept cap
+/// and micro-slip): `damping` while the total `trial` (spring before any slip plus
+/// dashpot, N) is within `cap` (N); above it the total is `trial` scaled to the cap and
+/// the dashpot takes what the spring after its slip, `kept` (N), does not hold (along the
+/// trial, against the slip).
+#[inline(always)]
+fn dashpot_takes_rest<R: Real>(trial: Vector2<R>, kept: Vector2<R>, damping: Vector2<R>, cap: R) -> Vector2<R> {
+    let f = trial.norm();
+    // cap >= 0, so a sliding contact has f > 0.
+    let slide = f.simd_gt(cap);
+    pick2(slide, trial * (cap / f) - kept, damping)
+}
+
 /// LIGGGHTS `tangential history`: a total tangential displacement `xi`, advanced by
 /// `vt dt` and projected onto the current tangent line each step; `Ft = -kt xi - gt vt`
 /// while sticking. When `|kt xi| > mu |Fn|` the contact slides: the force is the
@@ -306,10 +319,7 @@ impl Tangential for TotalForceCapSpringKept {
         let scale = pick(over, inp.cap / f_el, R::one());
         let slip_energy = slip_to(xi, inp.kt, scale, over);
         let kept = *xi * -inp.kt;
-        // Sliding: the trial force at the cap, of which the dashpot takes what the spring
-        // does not hold (along the trial, against the slip).
-        let total = trial * (inp.cap / f);
-        TangentialForce { elastic: kept, damping: pick2(slide, total - kept, damping), slip_energy }
+        TangentialForce { elastic: kept, damping: dashpot_takes_rest(trial, kept, damping, inp.cap), slip_energy }
     }
 }
 
@@ -483,11 +493,7 @@ impl Tangential for MicroSlip {
         h.kt = kt;
         let elastic = t * -sum;
         let damping = inp.vt * -inp.gt;
-        let total = elastic + damping;
-        let f = total.norm();
-        // cap >= 0, so a sliding contact has f > 0.
-        let slide = f.simd_gt(inp.cap);
-        TangentialForce { elastic, damping: pick2(slide, total * (inp.cap / f) - elastic, damping), slip_energy: slip }
+        TangentialForce { elastic, damping: dashpot_takes_rest(elastic + damping, elastic, damping, inp.cap), slip_energy: slip }
     }
     #[inline(always)]
     fn gather(h: [&MicroSlipState<f64>; crate::physics::lanes::LANES]) -> MicroSlipState<crate::physics::lanes::Lanes> {
