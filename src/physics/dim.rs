@@ -1,6 +1,8 @@
-//! The plane: vectors, the 2D cross product, and what a "2D grain" weighs.
+//! Dimensions: the [`Dim`] trait that lets one source serve the plane and space, its two
+//! instances [`Plane`] (2D, every engine today) and [`Space`] (3D: the contact laws so
+//! far, issue 30), and what a "2D grain" weighs.
 //!
-//! grainlab is 2D: grains move in the xy-plane and spin about z. The force law is the
+//! In the plane, grains move in the xy-plane and spin about z. The force law is the
 //! 3D Hertz-Mindlin law in every case; what differs between the two grain shapes is
 //! only mass and moment of inertia, exactly as in the reference codes:
 //! - [`GrainShape::SphereInPlane`] (default): spheres whose centres stay in the plane,
@@ -8,9 +10,194 @@
 //! - [`GrainShape::Disk`]: cylinders of a stated thickness t, m = pi r^2 t rho,
 //!   I = 1/2 m r^2 (LIGGGHTS `dimension 2` with t = 1 m).
 
+use std::f64::consts::PI;
+use std::fmt::Debug;
+use std::ops::{Add, AddAssign, Mul, Neg, Sub, SubAssign};
+
+use nalgebra::{Vector2, Vector3};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
-use std::f64::consts::PI;
+
+use crate::physics::lanes::{Lanes, Real, gather, pick};
+
+/// The number of dimensions as a type, after rapier's and nalgebra's `dim2`/`dim3`: the
+/// vector and spin types of one contact (`R = f64`) or four in lanes (`R = Lanes`), and
+/// the few operations whose form depends on the dimension (cross products, the turn of
+/// a contact frame). Code generic over `D: Dim` is written once and compiled for each;
+/// with [`Plane`] it is the same operations, in the same order, as the 2D code it
+/// replaced, so 2D keeps its bits (tests/properties.rs).
+pub trait Dim: Copy + Default + Debug + Send + Sync + 'static {
+    /// Number of space dimensions.
+    const D: usize;
+    /// `"plane"` or `"space"`, for messages.
+    const NAME: &'static str;
+    /// A vector (position, velocity, force: m, m/s, N).
+    type Vector<R: Real>: Copy
+        + Default
+        + Debug
+        + Send
+        + Sync
+        + Add<Output = Self::Vector<R>>
+        + Sub<Output = Self::Vector<R>>
+        + Neg<Output = Self::Vector<R>>
+        + Mul<R, Output = Self::Vector<R>>
+        + AddAssign
+        + SubAssign;
+    /// A spin or a torque: a number about z in the plane, a vector in space (rad/s, N m).
+    type Spin<R: Real>: Copy + Default + Debug + Send + Sync + Add<Output = Self::Spin<R>> + Mul<R, Output = Self::Spin<R>>;
+    /// What turns a contact about its normal: the pair's spin sum `w_i + w_j` in space
+    /// (rad/s); `()` in the plane, where every spin is perpendicular to the normal.
+    type Twist<R: Real>: Copy + Default + Debug + Send + Sync;
+    /// A vector as a checkpoint stores it (the same numbers).
+    type Saved: Copy + Debug + serde::Serialize + serde::de::DeserializeOwned;
+    fn zero<R: Real>() -> Self::Vector<R>;
+    fn dot<R: Real>(a: Self::Vector<R>, b: Self::Vector<R>) -> R;
+    fn norm_squared<R: Real>(a: Self::Vector<R>) -> R;
+    fn norm<R: Real>(a: Self::Vector<R>) -> R;
+    /// `a` where `mask` holds, else `b`, lane by lane.
+    fn pick<R: Real>(mask: R::SimdBool, a: Self::Vector<R>, b: Self::Vector<R>) -> Self::Vector<R>;
+    /// Vector lanes filled from `f(lane)`.
+    fn gather(f: impl Fn(usize) -> Self::Vector<f64>) -> Self::Vector<Lanes>;
+    /// One lane of a vector of lanes.
+    fn lane(v: &Self::Vector<Lanes>, l: usize) -> Self::Vector<f64>;
+    fn save(v: Self::Vector<f64>) -> Self::Saved;
+    fn load(s: Self::Saved) -> Self::Vector<f64>;
+    /// `w x a`: the velocity of a point at `a` from the centre of a grain spinning at `w`.
+    fn spin_cross<R: Real>(w: Self::Spin<R>, a: Self::Vector<R>) -> Self::Vector<R>;
+    /// `a x b` (a torque from an arm and a force).
+    fn cross<R: Real>(a: Self::Vector<R>, b: Self::Vector<R>) -> Self::Spin<R>;
+    /// A vector attached to a contact (YADE's elastic shear force) carried along as the
+    /// contact frame turns during one step, to first order as YADE's `ScGeom::rotate`:
+    /// `f -= f x (n_prev x n)`, then about the old normal by the pair's mean spin along
+    /// it, `f -= f x (dt/2 (n_prev . spin_sum) n_prev)`, with `spin_sum = w_i + w_j`
+    /// (rad/s). In the plane every spin is along z, perpendicular to every normal, so the
+    /// second turn is none.
+    fn turn<R: Real>(f: Self::Vector<R>, n_prev: Self::Vector<R>, n: Self::Vector<R>, spin_sum: Self::Twist<R>, dt: R) -> Self::Vector<R>;
+}
+
+/// Two dimensions: grains in the xy-plane spinning about z (every engine today).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Plane;
+
+/// Three dimensions: spheres in space, spins about any axis.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Space;
+
+impl Dim for Plane {
+    const D: usize = 2;
+    const NAME: &'static str = "plane";
+    type Vector<R: Real> = Vector2<R>;
+    type Spin<R: Real> = R;
+    type Twist<R: Real> = ();
+    type Saved = Vector2<f64>;
+    #[inline(always)]
+    fn zero<R: Real>() -> Vector2<R> {
+        Vector2::zeros()
+    }
+    #[inline(always)]
+    fn dot<R: Real>(a: Vector2<R>, b: Vector2<R>) -> R {
+        a.dot(&b)
+    }
+    #[inline(always)]
+    fn norm_squared<R: Real>(a: Vector2<R>) -> R {
+        a.norm_squared()
+    }
+    #[inline(always)]
+    fn norm<R: Real>(a: Vector2<R>) -> R {
+        a.norm()
+    }
+    #[inline(always)]
+    fn pick<R: Real>(mask: R::SimdBool, a: Vector2<R>, b: Vector2<R>) -> Vector2<R> {
+        crate::physics::lanes::pick2(mask, a, b)
+    }
+    #[inline(always)]
+    fn gather(f: impl Fn(usize) -> Vector2<f64>) -> Vector2<Lanes> {
+        crate::physics::lanes::gather2(f)
+    }
+    #[inline(always)]
+    fn lane(v: &Vector2<Lanes>, l: usize) -> Vector2<f64> {
+        crate::physics::lanes::lane2(v, l)
+    }
+    fn save(v: Vector2<f64>) -> Vector2<f64> {
+        v
+    }
+    fn load(s: Vector2<f64>) -> Vector2<f64> {
+        s
+    }
+    #[inline(always)]
+    fn spin_cross<R: Real>(w: R, a: Vector2<R>) -> Vector2<R> {
+        Vector2::new(-w * a.y, w * a.x)
+    }
+    #[inline(always)]
+    fn cross<R: Real>(a: Vector2<R>, b: Vector2<R>) -> R {
+        cross(a, b)
+    }
+    #[inline(always)]
+    fn turn<R: Real>(f: Vector2<R>, n_prev: Vector2<R>, n: Vector2<R>, _spin_sum: (), _dt: R) -> Vector2<R> {
+        // The axis n_prev x n is along z, and f - f x (s z) = f + (-f_y, f_x) s.
+        let s = cross(n_prev, n);
+        f + Vector2::new(-f.y, f.x) * s
+    }
+}
+
+impl Dim for Space {
+    const D: usize = 3;
+    const NAME: &'static str = "space";
+    type Vector<R: Real> = Vector3<R>;
+    type Spin<R: Real> = Vector3<R>;
+    type Twist<R: Real> = Vector3<R>;
+    type Saved = Vector3<f64>;
+    #[inline(always)]
+    fn zero<R: Real>() -> Vector3<R> {
+        Vector3::zeros()
+    }
+    #[inline(always)]
+    fn dot<R: Real>(a: Vector3<R>, b: Vector3<R>) -> R {
+        a.dot(&b)
+    }
+    #[inline(always)]
+    fn norm_squared<R: Real>(a: Vector3<R>) -> R {
+        a.norm_squared()
+    }
+    #[inline(always)]
+    fn norm<R: Real>(a: Vector3<R>) -> R {
+        a.norm()
+    }
+    #[inline(always)]
+    fn pick<R: Real>(mask: R::SimdBool, a: Vector3<R>, b: Vector3<R>) -> Vector3<R> {
+        Vector3::new(pick(mask, a.x, b.x), pick(mask, a.y, b.y), pick(mask, a.z, b.z))
+    }
+    #[inline(always)]
+    fn gather(f: impl Fn(usize) -> Vector3<f64>) -> Vector3<Lanes> {
+        Vector3::new(gather(|l| f(l).x), gather(|l| f(l).y), gather(|l| f(l).z))
+    }
+    #[inline(always)]
+    fn lane(v: &Vector3<Lanes>, l: usize) -> Vector3<f64> {
+        use simba::simd::SimdValue;
+        Vector3::new(v.x.extract(l), v.y.extract(l), v.z.extract(l))
+    }
+    fn save(v: Vector3<f64>) -> Vector3<f64> {
+        v
+    }
+    fn load(s: Vector3<f64>) -> Vector3<f64> {
+        s
+    }
+    #[inline(always)]
+    fn spin_cross<R: Real>(w: Vector3<R>, a: Vector3<R>) -> Vector3<R> {
+        w.cross(&a)
+    }
+    #[inline(always)]
+    fn cross<R: Real>(a: Vector3<R>, b: Vector3<R>) -> Vector3<R> {
+        a.cross(&b)
+    }
+    #[inline(always)]
+    fn turn<R: Real>(f: Vector3<R>, n_prev: Vector3<R>, n: Vector3<R>, spin_sum: Vector3<R>, dt: R) -> Vector3<R> {
+        let f = f - f.cross(&n_prev.cross(&n));
+        let twist = n_prev * (dt * crate::physics::lanes::k::<R>(0.5) * n_prev.dot(&spin_sum));
+        f - f.cross(&twist)
+    }
+}
+
 
 /// A vector in the plane, m (or m/s, N, ...).
 pub type Vec2 = nalgebra::Vector2<f64>;

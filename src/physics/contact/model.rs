@@ -403,7 +403,7 @@ impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling> ContactMod
             if self.options.lever_arm == LeverArm::Yade {
                 vt += (c.v_rel - c.n * c.v_rel.dot(&c.n)) * (c.tangential_scale - R::one());
             }
-            let inp = TangentialInput { n: c.n, vt, kt: st.kt, gt, cap: pm.friction * cap_force.simd_abs(), dt: c.dt };
+            let inp = TangentialInput { n: c.n, vt, kt: st.kt, gt, cap: pm.friction * cap_force.simd_abs(), dt: c.dt, twist: () };
             tf = T::force(&mut h.0, &inp);
         }
         force += tf.elastic + tf.damping;

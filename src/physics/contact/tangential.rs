@@ -4,19 +4,25 @@
 //! part, m/s, of grain i relative to grain j), the tangential stiffness `kt` (N/m), the
 //! damping coefficient `gt` (kg/s), the Coulomb cap `mu |Fn|` (N) and the time step, and
 //! returns the elastic and the damping part of the tangential force on grain i.
+//!
+//! The laws are written once for the plane and for space ([`Dim`]): the total
+//! displacement, the two total-force caps and YADE's increments in both (in space the
+//! history lives in the tangent plane, and YADE's force turns with the contact frame about
+//! the normal too); micro-slip, whose bed of springs lies along one tangent, in the plane
+//! only.
 
 use nalgebra::Vector2;
 
-use crate::physics::dim::cross;
-use crate::physics::lanes::{Real, k, pick, pick2};
+use crate::physics::dim::{Dim, Plane};
+use crate::physics::lanes::{Real, k, pick};
 
 /// What a tangential formulation needs of one contact (or one per lane) at one step.
 #[derive(Clone, Copy, Debug)]
-pub struct TangentialInput<R: Real = f64> {
+pub struct TangentialInput<R: Real = f64, D: Dim = Plane> {
     /// Unit normal, from j to i.
-    pub n: Vector2<R>,
+    pub n: D::Vector<R>,
     /// Tangential relative velocity of the contact points (i relative to j), m/s.
-    pub vt: Vector2<R>,
+    pub vt: D::Vector<R>,
     /// Tangential stiffness, N/m.
     pub kt: R,
     /// Tangential damping coefficient, kg/s.
@@ -25,23 +31,26 @@ pub struct TangentialInput<R: Real = f64> {
     pub cap: R,
     /// Time step, s.
     pub dt: R,
+    /// What turns the contact about its normal: the pair's spin sum `w_i + w_j` in space
+    /// (rad/s); nothing in the plane, where every spin is perpendicular to the normal.
+    pub twist: D::Twist<R>,
 }
 
 /// The tangential force on grain i, split for the energy balance.
 #[derive(Clone, Copy, Debug, Default)]
-pub struct TangentialForce<R: Real = f64> {
+pub struct TangentialForce<R: Real = f64, D: Dim = Plane> {
     /// Elastic (spring) part, N.
-    pub elastic: Vector2<R>,
+    pub elastic: D::Vector<R>,
     /// Viscous part, N.
-    pub damping: Vector2<R>,
+    pub damping: D::Vector<R>,
     /// Elastic energy removed from the spring by sliding at this step, J.
     pub slip_energy: R,
 }
 
 /// A tangential formulation, written once for one contact (`R = f64`) and for four
 /// contacts in lanes (`R = Lanes`), without branches on the data: sliding or sticking
-/// is a select.
-pub trait Tangential: Copy + Default + Send + Sync + 'static {
+/// is a select; and for the plane (`D = Plane`, the default) or for space.
+pub trait Tangential<D: Dim = Plane>: Copy + Default + Send + Sync + 'static {
     const NAME: &'static str;
     /// False for frictionless contacts: no tangential force, no torque, no spin.
     const FRICTION: bool;
@@ -52,7 +61,7 @@ pub trait Tangential: Copy + Default + Send + Sync + 'static {
     type Saved: serde::Serialize + serde::de::DeserializeOwned;
     fn save(h: Self::History<f64>) -> Self::Saved;
     fn load(s: Self::Saved) -> Self::History<f64>;
-    fn force<R: Real>(h: &mut Self::History<R>, inp: &TangentialInput<R>) -> TangentialForce<R>;
+    fn force<R: Real>(h: &mut Self::History<R>, inp: &TangentialInput<R, D>) -> TangentialForce<R, D>;
     /// Four contacts' states in lanes.
     fn gather(h: [&Self::History<f64>; crate::physics::lanes::LANES]) -> Self::History<crate::physics::lanes::Lanes>;
     /// Lane `l` of a state in lanes.
@@ -63,7 +72,7 @@ pub trait Tangential: Copy + Default + Send + Sync + 'static {
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Frictionless;
 
-impl Tangential for Frictionless {
+impl<D: Dim> Tangential<D> for Frictionless {
     const NAME: &'static str = "Frictionless";
     const FRICTION: bool = false;
     type History<R: Real> = ();
@@ -71,7 +80,7 @@ impl Tangential for Frictionless {
     fn save(_: ()) {}
     fn load(_: ()) {}
     #[inline(always)]
-    fn force<R: Real>(_: &mut (), _: &TangentialInput<R>) -> TangentialForce<R> {
+    fn force<R: Real>(_: &mut (), _: &TangentialInput<R, D>) -> TangentialForce<R, D> {
         TangentialForce::default()
     }
     #[inline(always)]
@@ -86,31 +95,31 @@ impl Tangential for Frictionless {
 macro_rules! displacement_history {
     () => {
         /// The tangential displacement xi, m.
-        type History<R: Real> = Vector2<R>;
-        type Saved = Vector2<f64>;
-        fn save(xi: Vector2<f64>) -> Vector2<f64> {
-            xi
+        type History<R: Real> = D::Vector<R>;
+        type Saved = D::Saved;
+        fn save(xi: D::Vector<f64>) -> D::Saved {
+            D::save(xi)
         }
-        fn load(xi: Vector2<f64>) -> Vector2<f64> {
-            xi
-        }
-        #[inline(always)]
-        fn gather(h: [&Vector2<f64>; crate::physics::lanes::LANES]) -> Vector2<crate::physics::lanes::Lanes> {
-            crate::physics::lanes::gather2(|l| *h[l])
+        fn load(xi: D::Saved) -> D::Vector<f64> {
+            D::load(xi)
         }
         #[inline(always)]
-        fn lane(h: &Vector2<crate::physics::lanes::Lanes>, l: usize) -> Vector2<f64> {
-            crate::physics::lanes::lane2(h, l)
+        fn gather(h: [&D::Vector<f64>; crate::physics::lanes::LANES]) -> D::Vector<crate::physics::lanes::Lanes> {
+            D::gather(|l| *h[l])
+        }
+        #[inline(always)]
+        fn lane(h: &D::Vector<crate::physics::lanes::Lanes>, l: usize) -> D::Vector<f64> {
+            D::lane(h, l)
         }
     };
 }
 
 /// One step of a total displacement as LIGGGHTS keeps it: `xi += vt dt`, then projected
-/// onto the current tangent line (the part along the normal `n` removed).
+/// onto the current tangent line or plane (the part along the normal `n` removed).
 #[inline(always)]
-fn advance_on_tangent<R: Real>(xi: &mut Vector2<R>, inp: &TangentialInput<R>) {
+fn advance_on_tangent<R: Real, D: Dim>(xi: &mut D::Vector<R>, inp: &TangentialInput<R, D>) {
     *xi += inp.vt * inp.dt;
-    let along_n = xi.dot(&inp.n);
+    let along_n = D::dot(*xi, inp.n);
     *xi -= inp.n * along_n;
 }
 
@@ -118,11 +127,11 @@ fn advance_on_tangent<R: Real>(xi: &mut Vector2<R>, inp: &TangentialInput<R>) {
 /// displacement whose spring gives the capped force), and the elastic energy the slip
 /// took from the spring, `kt (|xi|^2 - |xi'|^2) / 2` (0 elsewhere), J.
 #[inline(always)]
-fn slip_to<R: Real>(xi: &mut Vector2<R>, kt: R, scale: R, slide: R::SimdBool) -> R {
-    let before = k::<R>(0.5) * kt * xi.norm_squared();
+fn slip_to<R: Real, D: Dim>(xi: &mut D::Vector<R>, kt: R, scale: R, slide: R::SimdBool) -> R {
+    let before = k::<R>(0.5) * kt * D::norm_squared(*xi);
     let xi_slid = *xi * scale;
-    let after = k::<R>(0.5) * kt * xi_slid.norm_squared();
-    *xi = pick2(slide, xi_slid, *xi);
+    let after = k::<R>(0.5) * kt * D::norm_squared(xi_slid);
+    *xi = D::pick(slide, xi_slid, *xi);
     pick(slide, before - after, R::zero())
 }
 
@@ -132,11 +141,11 @@ fn slip_to<R: Real>(xi: &mut Vector2<R>, kt: R, scale: R, slide: R::SimdBool) ->
 /// the dashpot takes what the spring after its slip, `kept` (N), does not hold (along the
 /// trial, against the slip).
 #[inline(always)]
-fn dashpot_takes_rest<R: Real>(trial: Vector2<R>, kept: Vector2<R>, damping: Vector2<R>, cap: R) -> Vector2<R> {
-    let f = trial.norm();
+fn dashpot_takes_rest<R: Real, D: Dim>(trial: D::Vector<R>, kept: D::Vector<R>, damping: D::Vector<R>, cap: R) -> D::Vector<R> {
+    let f = D::norm(trial);
     // cap >= 0, so a sliding contact has f > 0.
     let slide = f.simd_gt(cap);
-    pick2(slide, trial * (cap / f) - kept, damping)
+    D::pick(slide, trial * (cap / f) - kept, damping)
 }
 
 /// LIGGGHTS `tangential history`: a total tangential displacement `xi`, advanced by
@@ -146,80 +155,88 @@ fn dashpot_takes_rest<R: Real>(trial: Vector2<R>, kept: Vector2<R>, damping: Vec
 #[derive(Clone, Copy, Debug, Default)]
 pub struct TotalDisplacement;
 
-impl Tangential for TotalDisplacement {
+impl<D: Dim> Tangential<D> for TotalDisplacement {
     const NAME: &'static str = "TotalDisplacementHistory";
     const FRICTION: bool = true;
     displacement_history!();
     #[inline(always)]
-    fn force<R: Real>(xi: &mut Vector2<R>, inp: &TangentialInput<R>) -> TangentialForce<R> {
+    fn force<R: Real>(xi: &mut D::Vector<R>, inp: &TangentialInput<R, D>) -> TangentialForce<R, D> {
         advance_on_tangent(xi, inp);
         let elastic = *xi * -inp.kt;
-        let f_el = elastic.norm();
+        let f_el = D::norm(elastic);
         // cap >= 0, so a sliding contact has f_el > 0.
         let slide = f_el.simd_gt(inp.cap);
         let scale = pick(slide, inp.cap / f_el, R::one());
         let scaled = elastic * scale;
         // The displacement that gives the capped force: -scaled/kt = xi scale.
-        let slip_energy = slip_to(xi, inp.kt, scale, slide);
+        let slip_energy = slip_to::<R, D>(xi, inp.kt, scale, slide);
         let damping = inp.vt * -inp.gt;
-        TangentialForce { elastic: scaled, damping: pick2(slide, Vector2::zeros(), damping), slip_energy }
+        TangentialForce { elastic: scaled, damping: D::pick(slide, D::zero(), damping), slip_energy }
     }
 }
 
 /// State of a YADE-style incremental contact.
-#[derive(Clone, Copy, Debug, Default, serde::Serialize, serde::Deserialize)]
-pub struct IncrementalState<R: Real = f64> {
+#[derive(Clone, Copy, Debug, Default)]
+pub struct IncrementalState<R: Real = f64, D: Dim = Plane> {
     /// Elastic tangential force on grain i, N.
-    pub force: Vector2<R>,
+    pub force: D::Vector<R>,
     /// The normal at the previous step (zero before the first step of a contact).
-    pub n_prev: Vector2<R>,
+    pub n_prev: D::Vector<R>,
+}
+
+/// An incremental contact's state as a checkpoint stores it: the same two vectors, in
+/// the same order.
+#[derive(Clone, Copy, Debug, serde::Serialize, serde::Deserialize)]
+#[serde(bound = "")]
+pub struct IncrementalSaved<D: Dim = Plane> {
+    /// Elastic tangential force on grain i, N.
+    pub force: D::Saved,
+    /// The normal at the previous step.
+    pub n_prev: D::Saved,
 }
 
 /// YADE `Law2_ScGeom_MindlinPhys_Mindlin`: the elastic tangential force is rotated with
-/// the contact frame (to first order, as YADE's `ScGeom::rotate`) and incremented by
+/// the contact frame (to first order, as YADE's `ScGeom::rotate`, [`Dim::turn`]: in
+/// space about the normal too, by the pair's mean spin along it) and incremented by
 /// `-kt vt dt` with `kt` at the current overlap; Coulomb caps the elastic part; the
 /// viscous part `-gt vt` is added on top while sticking.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct IncrementalForce;
 
-impl Tangential for IncrementalForce {
+impl<D: Dim> Tangential<D> for IncrementalForce {
     const NAME: &'static str = "IncrementalForce";
     const FRICTION: bool = true;
-    type History<R: Real> = IncrementalState<R>;
-    type Saved = IncrementalState<f64>;
-    fn save(h: IncrementalState<f64>) -> IncrementalState<f64> {
-        h
+    type History<R: Real> = IncrementalState<R, D>;
+    type Saved = IncrementalSaved<D>;
+    fn save(h: IncrementalState<f64, D>) -> IncrementalSaved<D> {
+        IncrementalSaved { force: D::save(h.force), n_prev: D::save(h.n_prev) }
     }
-    fn load(h: IncrementalState<f64>) -> IncrementalState<f64> {
-        h
+    fn load(s: IncrementalSaved<D>) -> IncrementalState<f64, D> {
+        IncrementalState { force: D::load(s.force), n_prev: D::load(s.n_prev) }
     }
     #[inline(always)]
-    fn force<R: Real>(h: &mut IncrementalState<R>, inp: &TangentialInput<R>) -> TangentialForce<R> {
+    fn force<R: Real>(h: &mut IncrementalState<R, D>, inp: &TangentialInput<R, D>) -> TangentialForce<R, D> {
         let n = inp.n;
-        // Rotate with the normal: in the plane the axis n_prev x n is along z and the
-        // first-order rotation adds (axis x F).
-        let s = cross(h.n_prev, n);
-        let f = h.force;
-        let rotated = f + Vector2::new(-f.y, f.x) * s;
+        let rotated = D::turn(h.force, h.n_prev, n, inp.twist, inp.dt);
         h.n_prev = n;
         let trial = rotated - inp.vt * inp.kt * inp.dt;
-        let f_el = trial.norm();
+        let f_el = D::norm(trial);
         // cap >= 0, so a sliding contact has f_el > 0 (and kt > 0: the trial force grew).
         let slide = f_el.simd_gt(inp.cap);
         let scaled = trial * (inp.cap / f_el);
-        let slip_energy = k::<R>(0.5) * (trial.norm_squared() - scaled.norm_squared()) / inp.kt;
-        let elastic = pick2(slide, scaled, trial);
+        let slip_energy = k::<R>(0.5) * (D::norm_squared(trial) - D::norm_squared(scaled)) / inp.kt;
+        let elastic = D::pick(slide, scaled, trial);
         h.force = elastic;
         let damping = inp.vt * -inp.gt;
-        TangentialForce { elastic, damping: pick2(slide, Vector2::zeros(), damping), slip_energy: pick(slide, slip_energy, R::zero()) }
+        TangentialForce { elastic, damping: D::pick(slide, D::zero(), damping), slip_energy: pick(slide, slip_energy, R::zero()) }
     }
     #[inline(always)]
-    fn gather(h: [&IncrementalState<f64>; crate::physics::lanes::LANES]) -> IncrementalState<crate::physics::lanes::Lanes> {
-        IncrementalState { force: crate::physics::lanes::gather2(|l| h[l].force), n_prev: crate::physics::lanes::gather2(|l| h[l].n_prev) }
+    fn gather(h: [&IncrementalState<f64, D>; crate::physics::lanes::LANES]) -> IncrementalState<crate::physics::lanes::Lanes, D> {
+        IncrementalState { force: D::gather(|l| h[l].force), n_prev: D::gather(|l| h[l].n_prev) }
     }
     #[inline(always)]
-    fn lane(h: &IncrementalState<crate::physics::lanes::Lanes>, l: usize) -> IncrementalState<f64> {
-        IncrementalState { force: crate::physics::lanes::lane2(&h.force, l), n_prev: crate::physics::lanes::lane2(&h.n_prev, l) }
+    fn lane(h: &IncrementalState<crate::physics::lanes::Lanes, D>, l: usize) -> IncrementalState<f64, D> {
+        IncrementalState { force: D::lane(&h.force, l), n_prev: D::lane(&h.n_prev, l) }
     }
 }
 
@@ -245,39 +262,40 @@ impl Tangential for IncrementalForce {
 #[derive(Clone, Copy, Debug, Default)]
 pub struct TotalForceCap;
 
-impl Tangential for TotalForceCap {
+impl<D: Dim> Tangential<D> for TotalForceCap {
     const NAME: &'static str = "TotalForceCapHistory";
     const FRICTION: bool = true;
     displacement_history!();
     #[inline(always)]
-    fn force<R: Real>(xi: &mut Vector2<R>, inp: &TangentialInput<R>) -> TangentialForce<R> {
+    fn force<R: Real>(xi: &mut D::Vector<R>, inp: &TangentialInput<R, D>) -> TangentialForce<R, D> {
         let n = inp.n;
-        // The frame turn: onto the tangent line, at the old length (0 if nothing is left).
-        let along = xi.dot(&n);
+        // The frame turn: onto the tangent line or plane, at the old length (0 if nothing
+        // is left).
+        let along = D::dot(*xi, n);
         let turned = (along.simd_abs() * inp.kt).simd_gt(k::<R>(1e-10) * inp.cap);
-        let length = xi.norm();
+        let length = D::norm(*xi);
         let projected = *xi - n * along;
-        let left = projected.norm();
+        let left = D::norm(projected);
         let rescale = pick(left.simd_gt(R::zero()), length / left, R::zero());
-        *xi = pick2(turned, projected * rescale, *xi);
+        *xi = D::pick(turned, projected * rescale, *xi);
         *xi += inp.vt * inp.dt;
         let damping = inp.vt * -inp.gt;
         let trial = *xi * -inp.kt + damping;
-        let f = trial.norm();
+        let f = D::norm(trial);
         // cap >= 0, so a sliding contact has f > 0.
         let slide = f.simd_gt(inp.cap);
-        let before = xi.norm_squared();
+        let before = D::norm_squared(*xi);
         let held = before.simd_gt(R::zero());
         let capped = trial * (inp.cap / f);
         let xi_slid = (capped - damping) * (-R::one() / inp.kt);
         // Sliding with a history: the capped force; sliding without one: no force at all.
-        *xi = pick2(slide & held, xi_slid, *xi);
+        *xi = D::pick(slide & held, xi_slid, *xi);
         // What the slip takes out of the spring; a slip that loads it (the dashpot's force
         // put in) is the law's own work, which the ledger counts in W_t.
-        let slip_energy = pick(slide & held, (k::<R>(0.5) * inp.kt * (before - xi.norm_squared())).simd_max(R::zero()), R::zero());
+        let slip_energy = pick(slide & held, (k::<R>(0.5) * inp.kt * (before - D::norm_squared(*xi))).simd_max(R::zero()), R::zero());
         let elastic = *xi * -inp.kt;
         let none = slide & !held;
-        TangentialForce { elastic: pick2(none, Vector2::zeros(), elastic), damping: pick2(none, Vector2::zeros(), damping), slip_energy }
+        TangentialForce { elastic: D::pick(none, D::zero(), elastic), damping: D::pick(none, D::zero(), damping), slip_energy }
     }
 }
 
@@ -301,25 +319,25 @@ impl Tangential for TotalForceCap {
 #[derive(Clone, Copy, Debug, Default)]
 pub struct TotalForceCapSpringKept;
 
-impl Tangential for TotalForceCapSpringKept {
+impl<D: Dim> Tangential<D> for TotalForceCapSpringKept {
     const NAME: &'static str = "TotalForceCapSpringKept";
     const FRICTION: bool = true;
     displacement_history!();
     #[inline(always)]
-    fn force<R: Real>(xi: &mut Vector2<R>, inp: &TangentialInput<R>) -> TangentialForce<R> {
+    fn force<R: Real>(xi: &mut D::Vector<R>, inp: &TangentialInput<R, D>) -> TangentialForce<R, D> {
         advance_on_tangent(xi, inp);
         let elastic = *xi * -inp.kt;
         let damping = inp.vt * -inp.gt;
         let trial = elastic + damping;
-        let f = trial.norm();
+        let f = D::norm(trial);
         // cap >= 0, so a sliding contact has f > 0 (and a spring over the cap f_el > 0).
         let slide = f.simd_gt(inp.cap);
-        let f_el = elastic.norm();
+        let f_el = D::norm(elastic);
         let over = slide & f_el.simd_gt(inp.cap);
         let scale = pick(over, inp.cap / f_el, R::one());
-        let slip_energy = slip_to(xi, inp.kt, scale, over);
+        let slip_energy = slip_to::<R, D>(xi, inp.kt, scale, over);
         let kept = *xi * -inp.kt;
-        TangentialForce { elastic: kept, damping: dashpot_takes_rest(trial, kept, damping, inp.cap), slip_energy }
+        TangentialForce { elastic: kept, damping: dashpot_takes_rest::<R, D>(trial, kept, damping, inp.cap), slip_energy }
     }
 }
 
@@ -493,7 +511,7 @@ impl Tangential for MicroSlip {
         h.kt = kt;
         let elastic = t * -sum;
         let damping = inp.vt * -inp.gt;
-        TangentialForce { elastic, damping: dashpot_takes_rest(elastic + damping, elastic, damping, inp.cap), slip_energy: slip }
+        TangentialForce { elastic, damping: dashpot_takes_rest::<R, Plane>(elastic + damping, elastic, damping, inp.cap), slip_energy: slip }
     }
     #[inline(always)]
     fn gather(h: [&MicroSlipState<f64>; crate::physics::lanes::LANES]) -> MicroSlipState<crate::physics::lanes::Lanes> {
@@ -515,7 +533,7 @@ mod tests {
     /// at tangential velocity `vt` (m/s), kt = 1e4 N/m, gt = 2 kg/s, dt = 1e-4 s, cap in N.
     fn step(xi: f64, vt: f64, cap: f64) -> (Vector2<f64>, TangentialForce<f64>) {
         let mut h = Vector2::new(xi, 0.0);
-        let inp = TangentialInput { n: Vector2::new(0.0, 1.0), vt: Vector2::new(vt, 0.0), kt: 1e4, gt: 2.0, cap, dt: 1e-4 };
+        let inp = TangentialInput { n: Vector2::new(0.0, 1.0), vt: Vector2::new(vt, 0.0), kt: 1e4, gt: 2.0, cap, dt: 1e-4, twist: () };
         let f = TotalForceCapSpringKept::force(&mut h, &inp);
         (h, f)
     }
@@ -568,7 +586,7 @@ mod microslip_tests {
         /// springs carry, N (the force on grain i is minus it along t).
         fn step(&mut self, dd: f64, kt: f64, cap: f64) -> f64 {
             let t = Vector2::new(-1.0, 0.0);
-            let inp = TangentialInput { n: Vector2::new(0.0, 1.0), vt: t * dd, kt, gt: 0.0, cap, dt: 1.0 };
+            let inp = TangentialInput { n: Vector2::new(0.0, 1.0), vt: t * dd, kt, gt: 0.0, cap, dt: 1.0, twist: () };
             let f = MicroSlip::force(&mut self.h, &inp);
             self.d += dd;
             self.slipped += f.slip_energy;
