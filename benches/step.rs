@@ -60,6 +60,7 @@ fn contact_kernel(c: &mut Criterion) {
         tangential_scale: 1.0,
         roll: 0.0,
         roll_scale: 1.0,
+        twist: (),
     };
     let options = ModelOptions { limit_force: false, lever_arm: LeverArm::Radius };
     let mut ledger = EnergyLedger::default();
@@ -82,6 +83,7 @@ fn contact_kernel(c: &mut Criterion) {
             tangential_scale: Lanes::splat(1.0),
             roll: Lanes::splat(0.0),
             roll_scale: Lanes::splat(1.0),
+            twist: (),
         };
         let pml = PairMaterial::gather([&pm; 4]);
         let xi = grainlab::physics::dim::Vec2::zeros();

@@ -5,7 +5,10 @@
 //! the code to that); `error` and `finite` serve them all.
 //!
 //! 1. **Physics** ([`physics`]): what a grain is ([`physics::dim`]: the plane, sphere in
-//!    the plane or disk; [`physics::particles`]: grain state as struct of arrays), the
+//!    the plane or disk, and the [`physics::dim::Dim`] trait that lets one source serve
+//!    the plane and space, so far the force of one contact and the tangential laws
+//!    (issue 30);
+//!    [`physics::particles`]: grain state as struct of arrays), the
 //!    materials and their mixing ([`physics::material`]), the contact law composed at
 //!    compile time ([`physics::contact`]: a normal law, Hertz or the linear spring; a
 //!    damping form, the one that returns e or LAMMPS' Tsuji fit; a tangential

@@ -97,6 +97,7 @@ fn lanes_match_alone<N: grainlab::physics::contact::normal::Normal, D: grainlab:
         tangential_scale: 1.0 + c[0] / 5e-4,
         roll: c[4] - c[2],
         roll_scale: 1.0 + c[0] / 2.5e-4,
+        twist: (),
     };
     let alone: Vec<_> = cs.iter().map(|c| {
         let mut h = (hist(c), rhist(c));
@@ -115,6 +116,7 @@ fn lanes_match_alone<N: grainlab::physics::contact::normal::Normal, D: grainlab:
         tangential_scale: gather(|l| one[l].tangential_scale),
         roll: gather(|l| one[l].roll),
         roll_scale: gather(|l| one[l].roll_scale),
+        twist: (),
     };
     let hs: Vec<_> = cs.iter().map(|c| (hist(c), rhist(c))).collect();
     let mut h = M::<N, D, T, Rr>::gather([&hs[0], &hs[1], &hs[2], &hs[3]]);

@@ -225,7 +225,7 @@ fn wall_input<T: Tangential, Rr: Rolling>(lever: crate::physics::contact::LeverA
     let ri = p.r[i];
     let spin = if T::FRICTION { lever.wall_arm(ri, dn) * p.omega[i] } else { 0.0 };
     let (roll, roll_scale) = if Rr::ON { (p.omega[i], lever.wall_rolling(ri, dn)) } else { (0.0, 1.0) };
-    ContactInput { n, dn, r_star: ri, sqrt_m_star: p.m[i].sqrt(), v_rel: p.v[i] - wall.v, spin, dt, tangential_scale: 1.0, roll, roll_scale }
+    ContactInput { n, dn, r_star: ri, sqrt_m_star: p.m[i].sqrt(), v_rel: p.v[i] - wall.v, spin, dt, tangential_scale: 1.0, roll, roll_scale, twist: () }
 }
 
 /// Record every touching contact of this step, grain-grain and grain-flat wall, as the

@@ -46,7 +46,7 @@ fn pair_input<R: Real, T: Tangential, Rr: Rolling, const SPIN: bool>(lever: Leve
     let spin = if T::FRICTION && SPIN { lever.arm(ri, dn) * wi + lever.arm(rj, dn) * wj } else { R::zero() };
     let tangential_scale = if T::FRICTION { lever.translation_scale(radsum, dn) } else { R::one() };
     let roll = if Rr::ON && SPIN { wi - wj } else { R::zero() };
-    ContactInput { n, dn, r_star, sqrt_m_star, v_rel, spin, dt, tangential_scale, roll, roll_scale: R::one() }
+    ContactInput { n, dn, r_star, sqrt_m_star, v_rel, spin, dt, tangential_scale, roll, roll_scale: R::one(), twist: () }
 }
 
 /// The torques to subtract from grains i and j: `-a n x Ft` and, with rolling

@@ -66,6 +66,11 @@ pub trait Dim: Copy + Default + Debug + Send + Sync + 'static {
     fn spin_cross<R: Real>(w: Self::Spin<R>, a: Self::Vector<R>) -> Self::Vector<R>;
     /// `a x b` (a torque from an arm and a force).
     fn cross<R: Real>(a: Self::Vector<R>, b: Self::Vector<R>) -> Self::Spin<R>;
+    /// `a x w` for a vector and a spin: with `w = a_i w_i + a_j w_j` and `a` the normal
+    /// from j to i, the spins' part of the velocity of i's contact point relative to j's.
+    fn cross_spin<R: Real>(a: Self::Vector<R>, w: Self::Spin<R>) -> Self::Vector<R>;
+    /// No spin, no torque.
+    fn spin_zero<R: Real>() -> Self::Spin<R>;
     /// A vector attached to a contact (YADE's elastic shear force) carried along as the
     /// contact frame turns during one step, to first order as YADE's `ScGeom::rotate`:
     /// `f -= f x (n_prev x n)`, then about the old normal by the pair's mean spin along
@@ -133,6 +138,14 @@ impl Dim for Plane {
         cross(a, b)
     }
     #[inline(always)]
+    fn cross_spin<R: Real>(a: Vector2<R>, w: R) -> Vector2<R> {
+        Vector2::new(a.y, -a.x) * w
+    }
+    #[inline(always)]
+    fn spin_zero<R: Real>() -> R {
+        R::zero()
+    }
+    #[inline(always)]
     fn turn<R: Real>(f: Vector2<R>, n_prev: Vector2<R>, n: Vector2<R>, _spin_sum: (), _dt: R) -> Vector2<R> {
         // The axis n_prev x n is along z, and f - f x (s z) = f + (-f_y, f_x) s.
         let s = cross(n_prev, n);
@@ -189,6 +202,14 @@ impl Dim for Space {
     #[inline(always)]
     fn cross<R: Real>(a: Vector3<R>, b: Vector3<R>) -> Vector3<R> {
         a.cross(&b)
+    }
+    #[inline(always)]
+    fn cross_spin<R: Real>(a: Vector3<R>, w: Vector3<R>) -> Vector3<R> {
+        a.cross(&w)
+    }
+    #[inline(always)]
+    fn spin_zero<R: Real>() -> Vector3<R> {
+        Vector3::zeros()
     }
     #[inline(always)]
     fn turn<R: Real>(f: Vector3<R>, n_prev: Vector3<R>, n: Vector3<R>, spin_sum: Vector3<R>, dt: R) -> Vector3<R> {

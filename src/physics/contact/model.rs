@@ -14,7 +14,7 @@ use super::rolling::{Cdt, Epsd2, InLanes, NoRolling, Rolling, RollingEnergy, Rol
 use super::damping::{Damping, LinearRestitution, TsujiFit, Undamped, Viscoelastic};
 use super::normal::{Hertz, Hooke, Normal};
 use super::tangential::{Frictionless, IncrementalForce, Tangential, TangentialForce, TangentialInput, TotalDisplacement, TotalForceCap, TotalForceCapSpringKept, MicroSlip};
-use crate::physics::dim::Vec2;
+use crate::physics::dim::{Dim, Plane, Vec2};
 use crate::physics::energy::{EnergyLedger, EnergySums};
 use crate::physics::lanes::{Real, k, pick};
 use crate::physics::material::PairMaterial;
@@ -112,11 +112,11 @@ pub struct ModelOptions {
 }
 
 /// What the kernel needs of one touching pair (or grain and wall) at one step; with
-/// `R = Lanes`, of four pairs.
+/// `R = Lanes`, of four pairs; in the plane (the default) or in space.
 #[derive(Clone, Copy, Debug)]
-pub struct ContactInput<R: Real = f64> {
+pub struct ContactInput<R: Real = f64, D: Dim = Plane> {
     /// Unit normal from j to i (from the wall into grain i).
-    pub n: Vector2<R>,
+    pub n: D::Vector<R>,
     /// Overlap dn > 0, m.
     pub dn: R,
     /// Reduced radius R*, m.
@@ -124,37 +124,41 @@ pub struct ContactInput<R: Real = f64> {
     /// Square root of the reduced mass m*, kg^1/2.
     pub sqrt_m_star: R,
     /// v_i - v_j at the centres, m/s.
-    pub v_rel: Vector2<R>,
-    /// a_i w_i + a_j w_j: the spin part of the contact-point velocity, m/s.
-    pub spin: R,
+    pub v_rel: D::Vector<R>,
+    /// a_i w_i + a_j w_j (arms in m, spins in rad/s): the spins' part of the contact-point
+    /// velocity is `n x` it, m/s.
+    pub spin: D::Spin<R>,
     /// Time step, s.
     pub dt: R,
     /// Factor on the translational part of the tangential velocity (1, except for YADE's
     /// ratcheting correction, [`LeverArm::translation_scale`]).
     pub tangential_scale: R,
     /// Relative spin w_i - w_j, rad/s (0 unless a rolling resistance reads it).
-    pub roll: R,
+    pub roll: D::Spin<R>,
     /// The rolling laws' factor on `roll` (1, except on LIGGGHTS' flat walls:
     /// [`LeverArm::wall_rolling`]).
     pub roll_scale: R,
+    /// What turns the contact about its normal for YADE's increments: `w_i + w_j` in
+    /// space (rad/s), `()` in the plane ([`crate::physics::dim::Dim::turn`]).
+    pub twist: D::Twist<R>,
 }
 
-impl<R: Real> ContactInput<R> {
+impl<R: Real, D: Dim> ContactInput<R, D> {
     /// Relative velocity of the contact points, i relative to j.
     #[inline(always)]
-    pub fn contact_velocity(&self) -> Vector2<R> {
-        self.v_rel + Vector2::new(self.n.y, -self.n.x) * self.spin
+    pub fn contact_velocity(&self) -> D::Vector<R> {
+        self.v_rel + D::cross_spin(self.n, self.spin)
     }
 }
 
 /// Everything one step of a touching contact computes: the force, and what the energy
 /// accounting reads.
 #[derive(Clone, Copy, Debug, Default)]
-pub struct ContactState<R: Real = f64> {
+pub struct ContactState<R: Real = f64, D: Dim = Plane> {
     /// Total force on i, N.
-    pub force: Vector2<R>,
+    pub force: D::Vector<R>,
     /// Tangential force on i, elastic and viscous parts.
-    pub tangential: TangentialForce<R>,
+    pub tangential: TangentialForce<R, D>,
     /// Normal force along n (after the clamp, if any), N.
     pub normal: R,
     /// Elastic part of the normal force, kn dn, N.
@@ -163,11 +167,11 @@ pub struct ContactState<R: Real = f64> {
     pub kn: R,
     pub kt: R,
     /// Relative velocity of the contact points, m/s.
-    pub vc: Vector2<R>,
+    pub vc: D::Vector<R>,
     /// Rolling torque on i (j gets the opposite), N m; 0 without rolling resistance.
-    pub rolling: R,
+    pub rolling: D::Spin<R>,
     /// The relative spin it acted against, w_i - w_j, rad/s (for the energy ledger).
-    pub roll: R,
+    pub roll: D::Spin<R>,
 }
 
 /// The force of one contact on grain i (grain j gets the opposite).
@@ -337,28 +341,29 @@ pub trait ContactLaw: Copy + Send + Sync + 'static {
 /// What a contact of tangential formulation `T` and rolling resistance `Rr` carries
 /// from step to step (one per lane with `R = Lanes`): their two states. Without rolling
 /// resistance the second is `()`, which takes no room.
-pub type Held<T, Rr, R = f64> = (<T as Tangential>::History<R>, <Rr as Rolling>::History<R>);
+pub type Held<T, Rr, R = f64, D = Plane> = (<T as Tangential<D>>::History<R>, <Rr as Rolling<D>>::History<R>);
 
 /// A contact model, composed from a normal law, a damping form, a tangential
 /// formulation, a cohesion model and a rolling resistance (none of the last two unless a
-/// scene asks for them).
+/// scene asks for them), in the plane (`D = Plane`, every engine today) or in space
+/// (the force of one contact so far; issue 30).
 #[derive(Clone, Copy, Debug)]
-pub struct ContactModel<N: Normal, Dm: Damping, T: Tangential, C: Cohesion = NoCohesion, Rr: Rolling = NoRolling> {
+pub struct ContactModel<N: Normal, Dm: Damping, T: Tangential<D>, C: Cohesion = NoCohesion, Rr: Rolling<D> = NoRolling, D: Dim = Plane> {
     pub options: ModelOptions,
     /// The normal law and its parameters (nothing for Hertz).
     pub normal: N,
     /// The rolling resistance and its parameters (nothing for most).
     pub rolling: Rr,
-    _p: PhantomData<(Dm, T, C)>,
+    _p: PhantomData<(Dm, T, C, D)>,
 }
 
-impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling + Default> ContactModel<N, Dm, T, C, Rr> {
+impl<N: Normal, Dm: Damping, T: Tangential<D>, C: Cohesion, Rr: Rolling<D> + Default, D: Dim> ContactModel<N, Dm, T, C, Rr, D> {
     pub fn new(options: ModelOptions, normal: N) -> Self {
         Self::with_rolling(options, normal, Rr::default())
     }
 }
 
-impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling> ContactModel<N, Dm, T, C, Rr> {
+impl<N: Normal, Dm: Damping, T: Tangential<D>, C: Cohesion, Rr: Rolling<D>, D: Dim> ContactModel<N, Dm, T, C, Rr, D> {
     /// A model whose rolling resistance has parameters.
     pub fn with_rolling(options: ModelOptions, normal: N, rolling: Rr) -> Self {
         ContactModel { options, normal, rolling, _p: PhantomData }
@@ -366,11 +371,11 @@ impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling> ContactMod
 
     /// Four contacts' states in lanes, and one lane of them.
     #[inline(always)]
-    pub fn gather(h: [&Held<T, Rr>; crate::physics::lanes::LANES]) -> Held<T, Rr, crate::physics::lanes::Lanes> {
+    pub fn gather(h: [&Held<T, Rr, f64, D>; crate::physics::lanes::LANES]) -> Held<T, Rr, crate::physics::lanes::Lanes, D> {
         (T::gather(h.map(|x| &x.0)), Rr::gather(h.map(|x| &x.1)))
     }
     #[inline(always)]
-    pub fn lane(h: &Held<T, Rr, crate::physics::lanes::Lanes>, l: usize) -> Held<T, Rr> {
+    pub fn lane(h: &Held<T, Rr, crate::physics::lanes::Lanes, D>, l: usize) -> Held<T, Rr, f64, D> {
         (T::lane(&h.0, l), Rr::lane(&h.1, l))
     }
 
@@ -378,11 +383,11 @@ impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling> ContactMod
     /// advancing its tangential state. No branch on the data: the same bits per lane as
     /// for the contact alone.
     #[inline(always)]
-    pub fn force<R: Real>(&self, c: &ContactInput<R>, pm: &PairMaterial<R>, h: &mut Held<T, Rr, R>) -> ContactState<R> {
+    pub fn force<R: Real>(&self, c: &ContactInput<R, D>, pm: &PairMaterial<R>, h: &mut Held<T, Rr, R, D>) -> ContactState<R, D> {
         let st = self.normal.stiffness(pm, c.r_star, c.sqrt_m_star, c.dn);
         let (gn, gt) = Dm::coefficients(pm, c.sqrt_m_star, &st);
         let vc = c.contact_velocity();
-        let vn = vc.dot(&c.n);
+        let vn = D::dot(vc, c.n);
         let mut elastic_n = st.kn * c.dn;
         // DMT: the pull-off force F0 = 2 pi w R* attracts while the bodies overlap.
         let pulloff = if C::ON { pm.pulloff * c.r_star } else { R::zero() };
@@ -401,9 +406,9 @@ impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling> ContactMod
         if T::FRICTION {
             let mut vt = vc - c.n * vn;
             if self.options.lever_arm == LeverArm::Yade {
-                vt += (c.v_rel - c.n * c.v_rel.dot(&c.n)) * (c.tangential_scale - R::one());
+                vt += (c.v_rel - c.n * D::dot(c.v_rel, c.n)) * (c.tangential_scale - R::one());
             }
-            let inp = TangentialInput { n: c.n, vt, kt: st.kt, gt, cap: pm.friction * cap_force.simd_abs(), dt: c.dt, twist: () };
+            let inp = TangentialInput { n: c.n, vt, kt: st.kt, gt, cap: pm.friction * cap_force.simd_abs(), dt: c.dt, twist: c.twist };
             tf = T::force(&mut h.0, &inp);
         }
         force += tf.elastic + tf.damping;
@@ -411,11 +416,14 @@ impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling> ContactMod
             let inp = RollingInput { w: c.roll * c.roll_scale, r_star: c.r_star, kt: st.kt, elastic_normal: st.kn * c.dn, normal: fnorm, mu: pm.rolling_friction, dt: c.dt };
             self.rolling.torque(&mut h.1, &inp)
         } else {
-            R::zero()
+            D::spin_zero()
         };
         ContactState { force, tangential: tf, normal: fnorm, elastic_normal: elastic_n, kn: st.kn, kt: st.kt, vc, rolling, roll: c.roll }
     }
 
+}
+
+impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling> ContactModel<N, Dm, T, C, Rr> {
     /// The force of a touching contact, updating its history; with `ENERGY`, this
     /// step's energy terms and stored energies go straight into `ledger` (the flat walls'
     /// contacts, which are few and run in one order).

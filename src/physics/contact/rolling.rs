@@ -24,13 +24,14 @@
 
 use simba::simd::SimdValue;
 
+use crate::physics::dim::{Dim, Plane};
 use crate::physics::lanes::{LANES, Lanes, Real, gather, k, pick};
 
 /// What a rolling law needs of one contact (or one per lane) at one step.
 #[derive(Clone, Copy, Debug)]
-pub struct RollingInput<R: Real = f64> {
+pub struct RollingInput<R: Real = f64, D: Dim = Plane> {
     /// Relative spin w_i - w_j as the law sees it, rad/s.
-    pub w: R,
+    pub w: D::Spin<R>,
     /// Reduced radius R* (the grain's radius on a flat wall), m.
     pub r_star: R,
     /// Tangential stiffness at this step, N/m (EPSD2's kr = kt R*^2).
@@ -46,8 +47,9 @@ pub struct RollingInput<R: Real = f64> {
 }
 
 /// A rolling-resistance law, compiled into the contact kernel (written once for one
-/// contact and for four in lanes, without branches on the data).
-pub trait Rolling: Copy + Send + Sync + std::fmt::Debug + 'static {
+/// contact and for four in lanes, without branches on the data). The laws are the
+/// plane's (a torque about z); in space only [`NoRolling`] so far.
+pub trait Rolling<D: Dim = Plane>: Copy + Send + Sync + std::fmt::Debug + 'static {
     /// Its name in `explain`.
     const NAME: &'static str;
     /// False: no rolling torque at all.
@@ -66,7 +68,7 @@ pub trait Rolling: Copy + Send + Sync + std::fmt::Debug + 'static {
     /// and four contacts' of it in lanes.
     type Energy: RollingEnergy<f64> + InLanes<Lanes: RollingEnergy<Lanes>> + PartialEq + serde::Serialize + serde::de::DeserializeOwned;
     /// The torque on grain i, N m (j gets the opposite), advancing the state `h`.
-    fn torque<R: Real>(&self, h: &mut Self::History<R>, inp: &RollingInput<R>) -> R;
+    fn torque<R: Real>(&self, h: &mut Self::History<R>, inp: &RollingInput<R, D>) -> D::Spin<R>;
     /// The law and its parameters, for `explain` and checkpoints.
     fn label(&self) -> String {
         Self::NAME.to_string()
@@ -169,7 +171,7 @@ impl<R: Real> RollingEnergy<R> for RollingMemory<R> {
 #[derive(Clone, Copy, Debug, Default)]
 pub struct NoRolling;
 
-impl Rolling for NoRolling {
+impl<D: Dim> Rolling<D> for NoRolling {
     const NAME: &'static str = "";
     const ON: bool = false;
     type Energy = ();
@@ -182,8 +184,8 @@ impl Rolling for NoRolling {
     #[inline(always)]
     fn lane(_: &(), _: usize) {}
     #[inline(always)]
-    fn torque<R: Real>(&self, _: &mut (), _: &RollingInput<R>) -> R {
-        R::zero()
+    fn torque<R: Real>(&self, _: &mut (), _: &RollingInput<R, D>) -> D::Spin<R> {
+        D::spin_zero()
     }
 }
 
