@@ -101,11 +101,14 @@ fn collision_restitution() {
     // 1.2e-4 to 3.0e-4 (9.3e-4 for dem09's 80 steps per contact: the first-order discrete
     // error), momentum 0 exactly (the pair force is equal and opposite).
     //
-    // dem01-hertz-tsuji-3d-si (the first with `damping tsuji`) is not asserted: grainlab's
-    // Tsuji damping is LAMMPS 20220106's (workbench tsuji/ cases to rounding), whose fit
-    // returns 0.616 for an input of 0.5 under Hertz (tests/tsuji.rs), while the suite's
-    // newer LAMMPS expects 0.5 within 2%: its Tsuji damping, or the case's set-up, must
-    // differ from 20220106's (not run here).
+    // dem01-hertz-tsuji-3d-si (`damping tsuji`, LAMMPS 4 Jul 2026; otherwise the
+    // twosphere case, with `tangential mindlin`) runs with `model.damping = "tsuji_sqrt2"`:
+    // the suite's LAMMPS multiplies the Tsuji fit by sqrt(2) (its
+    // src/GRANULAR/gran_sub_mod_damping.cpp), LAMMPS 20220106 does not, and grainlab has
+    // both ("tsuji" is 20220106's, the workbench's tsuji/ cases to rounding; its fit
+    // returns 0.616 for 0.5, tests/tsuji.rs). Measured 2.9e-4: a rebound of 0.99971374
+    // m/s, where the YAML records 0.99971769 from its LAMMPS (4.0e-6 apart; not asserted:
+    // no such LAMMPS runs here).
     let al = |e: f64, mu: f64| material(7e10, 0.33, 2700.0, e, mu);
     let mut cases = Vec::new();
     let mut s = head_on(al(0.5, 0.4), 0.0025, 4.0, 1000.0);
@@ -122,6 +125,14 @@ fn collision_restitution() {
     let mut s = head_on(material(1e4, 0.3, 1.0, 0.9, 0.0), 0.5, 2.0, 1000.0);
     s.model.normal = NormalLaw::HookeStiffness { kn: 1e4, kt: 8235.0 };
     cases.push(("dem09-normal-3d", s, 0.9, 1.0, 2e-4, 0.015));
+    let mut s = head_on(al(0.5, 0.4), 0.0025, 4.0, 1000.0);
+    if let Grains::List(g) = &mut s.grains {
+        g[0].omega = 22.0;
+        g[1].omega = -22.0;
+    }
+    s.model.damping = DampingSpec::TsujiSqrt2;
+    s.model.tangential = TangentialSpec::TotalForceCap;
+    cases.push(("dem01-hertz-tsuji", s, 0.5, 2.0, 1e-8, 0.02));
     for (name, mut s, e, vin, dt, tol) in cases {
         s.analysis = Analysis::None;
         s.time_step.rule = TimeStepRule::Fixed { dt };
@@ -374,14 +385,23 @@ fn terminal_velocity_wall_restitution_and_pulloff_dmt() {
     // dem11-regionwall-3d-si: a 5 mm grain (7000 kg/m^3), hertz KN 7.11111e10, e 0.5, at
     // 2 m/s onto a wall, dt 1e-8: v' = -e v, to LAMMPS' 0.01. LAMMPS' wall there is the
     // inside of a cylinder of radius 10 mm; grainlab's walls are flat (the closed form does
-    // not depend on the wall's curvature). dem03-hertz-tsuji-wall-3d-si, the same check
-    // with `damping tsuji`, is not asserted (collision_restitution above says why).
-    // Measured 4.6e-5.
+    // not depend on the wall's curvature). Measured 4.6e-5.
     let grain = material(youngs_for(7.11111e10, 0.3, false), 0.3, 7000.0, 0.5, 0.0);
     let mut s = on_floor(grain, None, 0.0025, 0.0026, [0.0, -2.0], 0.0, 1e-8);
     s.materials[1].youngs_modulus = 1e30;
     let st = run_steps(&s, 20500);
     assert!(rel(0.5 * 2.0, st.v[0].y) < 0.01, "v' {}", st.v[0].y);
+    // dem03-hertz-tsuji-wall-3d-si: a 5 mm Al grain (70 GPa, 0.33, 2700; e 0.5, mu 0.4) at
+    // 2 m/s onto a wall of its material, `damping tsuji tangential mindlin`, dt 1e-8, 7000
+    // steps: v' = -e v, to LAMMPS' 0.005. As dem01-hertz-tsuji (collision_restitution),
+    // the suite's LAMMPS multiplies the Tsuji fit by sqrt(2): "tsuji_sqrt2". Measured
+    // 2.6e-4: 0.99974370 m/s, where the YAML records 0.99974392 (2.2e-7 apart).
+    let al = material(7e10, 0.33, 2700.0, 0.5, 0.4);
+    let mut s = on_floor(al, None, 0.0025, 0.0026, [0.0, -2.0], 0.0, 1e-8);
+    s.model.damping = DampingSpec::TsujiSqrt2;
+    s.model.tangential = TangentialSpec::TotalForceCap;
+    let st = run_steps(&s, 7000);
+    assert!(rel(0.5 * 2.0, st.v[0].y) < 0.005, "v' {}", st.v[0].y);
     // dem08-dmt-wall-3d-si: a 20 mm grain (48 GPa, 0.2, 2800) touching a plane of its own
     // material at an overlap of 1e-17 m, DMT with LAMMPS' cohesion gamma 0.1 J/m^2: the
     // force is the pull-off force 4 pi gamma R (grainlab: work of adhesion w = 2 gamma,

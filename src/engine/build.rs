@@ -368,6 +368,7 @@ pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<B
     let threads = crate::kernels::threads::Threads::new(threads)?;
     let parts = Parts { p, boundary, walls, dt, skin, scene, threads, domain, context };
     let tsuji = scene.model.damping == DampingSpec::Tsuji;
+    let tsuji_sqrt2 = scene.model.damping == DampingSpec::TsujiSqrt2;
     let rolling = if effects.rolling { scene.model.rolling } else { RollingSpec::None };
     let engine: Box<dyn Engine> = match (scene.model.normal.hooke(), tangential, all_elastic) {
         // Rolling resistance, with the restitution damping (0 when every e = 1) and the
@@ -391,6 +392,13 @@ pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<B
         (Some(h), TangentialSpec::Frictionless, _) if tsuji => parts.assemble(HookeTsujiFrictionless::new(options, h))?,
         (Some(h), TangentialSpec::TotalForceCap, _) if tsuji => parts.assemble(HookeTsujiForceCap::new(options, h))?,
         (Some(h), _, _) if tsuji => parts.assemble(HookeTsujiHistory::new(options, h))?,
+        // LAMMPS' current Tsuji damping (the fit times sqrt(2)), the same combinations.
+        (None, TangentialSpec::Frictionless, _) if tsuji_sqrt2 => parts.assemble(HertzTsujiSqrt2Frictionless::new(options, Hertz))?,
+        (None, TangentialSpec::TotalForceCap, _) if tsuji_sqrt2 => parts.assemble(HertzTsujiSqrt2ForceCap::new(options, Hertz))?,
+        (None, _, _) if tsuji_sqrt2 => parts.assemble(HertzTsujiSqrt2History::new(options, Hertz))?,
+        (Some(h), TangentialSpec::Frictionless, _) if tsuji_sqrt2 => parts.assemble(HookeTsujiSqrt2Frictionless::new(options, h))?,
+        (Some(h), TangentialSpec::TotalForceCap, _) if tsuji_sqrt2 => parts.assemble(HookeTsujiSqrt2ForceCap::new(options, h))?,
+        (Some(h), _, _) if tsuji_sqrt2 => parts.assemble(HookeTsujiSqrt2History::new(options, h))?,
         (None, TangentialSpec::Frictionless, false) => parts.assemble(HertzFrictionless::new(options, Hertz))?,
         (None, TangentialSpec::Frictionless, true) => parts.assemble(HertzFrictionlessElastic::new(options, Hertz))?,
         (None, TangentialSpec::TotalDisplacement, false) => parts.assemble(LiggghtsHertzHistory::new(options, Hertz))?,

@@ -126,9 +126,10 @@ impl Effects {
         };
         push("rotation (spin integration, torques)", rotation, rotation_why, Some("rotation off"));
         let lossy = pairs.iter().find(|q| mix(q).restitution < 1.0);
-        let tsuji = scene.model.damping == crate::scene::DampingSpec::Tsuji;
+        let tsuji = scene.model.damping.tsuji().is_some();
         let damping_why = match lossy {
-            _ if tsuji => "declared: model.damping = tsuji (LAMMPS' fit alpha(e) sqrt(m* k); alpha(1) = 3e-4 damps e = 1 too, and the realised e is not the input e)".to_string(),
+            _ if scene.model.damping == crate::scene::DampingSpec::Tsuji => "declared: model.damping = tsuji (LAMMPS 20220106's fit alpha(e) sqrt(m* k); alpha(1) = 3e-4 damps e = 1 too, and the realised e is not the input e)".to_string(),
+            _ if tsuji => "declared: model.damping = tsuji_sqrt2 (LAMMPS' current fit sqrt(2) alpha(e) sqrt(m* k); alpha(1) = 3e-4 damps e = 1 too; under Hertz the realised e is the input within 1.1e-3)".to_string(),
             Some(&q) if scene.model.damping == crate::scene::DampingSpec::ClampedRestitution => {
                 let pm = mix(&q);
                 format!("derived: the {} pair has restitution {} < 1 (declared model.damping = clamped_restitution: beta = {:.6} returns it under the clamp, against beta(e) = {:.6})", pair_name(mats, q), pm.restitution, pm.beta, crate::physics::material::beta(pm.restitution))

@@ -22,7 +22,7 @@ use serde::Serialize;
 use crate::error::{Error, check};
 use crate::physics::contact::normal::NormalLaw;
 use crate::physics::material::{Material, PairMaterial, rayleigh_time};
-use crate::scene::{DampingSpec, ModelSpec, TimeStepRule};
+use crate::scene::{ModelSpec, TimeStepRule};
 
 /// A reference contact: reduced radius and mass, the pair's moduli, and the inverse
 /// tangential mass of the contact point.
@@ -87,8 +87,8 @@ fn verlet_limit(omega: f64, zeta: f64) -> f64 {
 /// stiffnesses are `kn` (secant) and `sn` (tangent).
 fn damping_ratios(model: &ModelSpec, c: &RefContact, kn: f64, sn: f64) -> (f64, f64) {
     let tangential_mass = (c.m_star * c.inv_tangential_mass).sqrt();
-    if model.damping == DampingSpec::Tsuji {
-        let half_alpha = 0.5 * crate::physics::contact::damping::tsuji_alpha(c.pair.restitution);
+    if let Some(factor) = model.damping.tsuji() {
+        let half_alpha = 0.5 * crate::physics::contact::damping::tsuji_alpha(c.pair.restitution) * factor;
         return (half_alpha * (kn / sn).sqrt(), half_alpha * tangential_mass);
     }
     let zeta_n = if model.normal == NormalLaw::Hertz { crate::physics::material::SQRT_FIVE_SIXTHS * c.pair.beta.abs() } else { c.pair.beta.abs() };

@@ -88,6 +88,35 @@ pub struct Plane;
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Space;
 
+/// The methods of [`Dim`] that both vector types have from nalgebra: the same calls as
+/// the 2D code made before it was generic.
+macro_rules! nalgebra_vector {
+    ($v:ident) => {
+        #[inline(always)]
+        fn zero<R: Real>() -> $v<R> {
+            $v::zeros()
+        }
+        #[inline(always)]
+        fn dot<R: Real>(a: $v<R>, b: $v<R>) -> R {
+            a.dot(&b)
+        }
+        #[inline(always)]
+        fn norm_squared<R: Real>(a: $v<R>) -> R {
+            a.norm_squared()
+        }
+        #[inline(always)]
+        fn norm<R: Real>(a: $v<R>) -> R {
+            a.norm()
+        }
+        fn save(v: $v<f64>) -> $v<f64> {
+            v
+        }
+        fn load(s: $v<f64>) -> $v<f64> {
+            s
+        }
+    };
+}
+
 impl Dim for Plane {
     const D: usize = 2;
     const NAME: &'static str = "plane";
@@ -95,22 +124,7 @@ impl Dim for Plane {
     type Spin<R: Real> = R;
     type Twist<R: Real> = ();
     type Saved = Vector2<f64>;
-    #[inline(always)]
-    fn zero<R: Real>() -> Vector2<R> {
-        Vector2::zeros()
-    }
-    #[inline(always)]
-    fn dot<R: Real>(a: Vector2<R>, b: Vector2<R>) -> R {
-        a.dot(&b)
-    }
-    #[inline(always)]
-    fn norm_squared<R: Real>(a: Vector2<R>) -> R {
-        a.norm_squared()
-    }
-    #[inline(always)]
-    fn norm<R: Real>(a: Vector2<R>) -> R {
-        a.norm()
-    }
+    nalgebra_vector!(Vector2);
     #[inline(always)]
     fn pick<R: Real>(mask: R::SimdBool, a: Vector2<R>, b: Vector2<R>) -> Vector2<R> {
         crate::physics::lanes::pick2(mask, a, b)
@@ -122,12 +136,6 @@ impl Dim for Plane {
     #[inline(always)]
     fn lane(v: &Vector2<Lanes>, l: usize) -> Vector2<f64> {
         crate::physics::lanes::lane2(v, l)
-    }
-    fn save(v: Vector2<f64>) -> Vector2<f64> {
-        v
-    }
-    fn load(s: Vector2<f64>) -> Vector2<f64> {
-        s
     }
     #[inline(always)]
     fn spin_cross<R: Real>(w: R, a: Vector2<R>) -> Vector2<R> {
@@ -160,22 +168,7 @@ impl Dim for Space {
     type Spin<R: Real> = Vector3<R>;
     type Twist<R: Real> = Vector3<R>;
     type Saved = Vector3<f64>;
-    #[inline(always)]
-    fn zero<R: Real>() -> Vector3<R> {
-        Vector3::zeros()
-    }
-    #[inline(always)]
-    fn dot<R: Real>(a: Vector3<R>, b: Vector3<R>) -> R {
-        a.dot(&b)
-    }
-    #[inline(always)]
-    fn norm_squared<R: Real>(a: Vector3<R>) -> R {
-        a.norm_squared()
-    }
-    #[inline(always)]
-    fn norm<R: Real>(a: Vector3<R>) -> R {
-        a.norm()
-    }
+    nalgebra_vector!(Vector3);
     #[inline(always)]
     fn pick<R: Real>(mask: R::SimdBool, a: Vector3<R>, b: Vector3<R>) -> Vector3<R> {
         Vector3::new(pick(mask, a.x, b.x), pick(mask, a.y, b.y), pick(mask, a.z, b.z))
@@ -188,12 +181,6 @@ impl Dim for Space {
     fn lane(v: &Vector3<Lanes>, l: usize) -> Vector3<f64> {
         use simba::simd::SimdValue;
         Vector3::new(v.x.extract(l), v.y.extract(l), v.z.extract(l))
-    }
-    fn save(v: Vector3<f64>) -> Vector3<f64> {
-        v
-    }
-    fn load(s: Vector3<f64>) -> Vector3<f64> {
-        s
     }
     #[inline(always)]
     fn spin_cross<R: Real>(w: Vector3<R>, a: Vector3<R>) -> Vector3<R> {

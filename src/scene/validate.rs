@@ -163,7 +163,7 @@ impl Scene {
                 check(finite_pos(kt), "model.normal.hooke_stiffness", "kt", kt, "> 0 N/m")?;
             }
         }
-        let tsuji = self.model.damping == DampingSpec::Tsuji;
+        let tsuji = self.model.damping.tsuji().is_some();
         // Micro-slip's bed of springs spans the Hertz contact radius (kt = 8 G* a).
         if self.model.tangential == TangentialSpec::MindlinDeresiewicz && !self.model.normal.is_hertz() {
             check(false, "model", "tangential", "\"mindlin_deresiewicz\"", &format!("another formulation with a linear spring (micro-slip spreads over the Hertz contact radius, kt = 8 G* a; compiled: {})", crate::physics::contact::model::COMPILED))?;
@@ -177,7 +177,8 @@ impl Scene {
             }
         }
         if tsuji && matches!(self.model.tangential, TangentialSpec::IncrementalForce | TangentialSpec::TotalForceCapSpringKept | TangentialSpec::MindlinDeresiewicz) {
-            check(false, "model", "damping", "tsuji", &format!("\"restitution\" with model.tangential = {} (compiled: {})", self.model.tangential.name(), crate::physics::contact::model::COMPILED))?;
+            let name = if self.model.damping == DampingSpec::Tsuji { "tsuji" } else { "tsuji_sqrt2" };
+            check(false, "model", "damping", name, &format!("\"restitution\" with model.tangential = {} (compiled: {})", self.model.tangential.name(), crate::physics::contact::model::COMPILED))?;
         }
         // DMT cohesion is compiled with the restitution damping, frictionless or with the
         // total displacement, and without the clamp (which would remove the attraction).

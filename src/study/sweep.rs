@@ -715,13 +715,13 @@ fn closed_form(s: &Scene) -> Option<Closed> {
     // with the clamp (beta(e) then returns more) or Tsuji's fit, both in closed form.
     use crate::physics::restitution::{clamped_restitution, restitution_of_beta};
     use crate::scene::DampingSpec;
-    let b = match s.model.damping {
-        DampingSpec::Tsuji => crate::physics::contact::damping::tsuji_alpha(m.restitution) / 5f64.sqrt(),
-        _ => s.model.beta_rule().beta(m.restitution).abs(),
+    let b = match s.model.damping.tsuji() {
+        Some(factor) => crate::physics::contact::damping::tsuji_alpha(m.restitution) * factor / 5f64.sqrt(),
+        None => s.model.beta_rule().beta(m.restitution).abs(),
     };
     let restitution = match (s.model.limit_force, s.model.damping) {
         // exp(-pi b / sqrt(1 - b^2)); b >= 1 never parts.
-        (false, DampingSpec::Tsuji) => restitution_of_beta(-b).unwrap_or(0.0),
+        (false, DampingSpec::Tsuji | DampingSpec::TsujiSqrt2) => restitution_of_beta(-b).unwrap_or(0.0),
         (false, _) => m.restitution,
         (true, DampingSpec::ClampedRestitution) => m.restitution,
         (true, _) => clamped_restitution(b),

@@ -365,6 +365,21 @@ fn tsuji_cases(out: &mut Vec<Case>) {
         s.description = format!("glass bead on {what} at 1 m/s, 45 deg, frictionless, Tsuji damping of e = 0.5, t_c/200");
         out.push(Case::new(name, s, vec![Code::Lammps], true));
     }
+    // LAMMPS' current Tsuji damping (`model.damping = "tsuji_sqrt2"`: the fit times
+    // sqrt(2)), run in LAMMPS 20220106 as its `damping tsuji` with the input whose fit
+    // gives it: head-on under Hertz (e = 0.2, 0.5, 0.8) and the given spring (e = 0.5) at
+    // t_c/500, and an oblique impact on a flat wall with LAMMPS' tangential law.
+    for (tag, law, e) in [("hertz", NormalLaw::Hertz, 0.2), ("hertz", NormalLaw::Hertz, 0.5), ("hertz", NormalLaw::Hertz, 0.8), ("spring", NormalLaw::HookeStiffness { kn: SPRING_KN, kt: SPRING_KT }, 0.5)] {
+        let mut s = builtin::head_on_under(law, glass(e), 1e-3, 1.0, 500.0);
+        s.model.damping = DampingSpec::TsujiSqrt2;
+        let name = format!("tsuji/sqrt2-{tag}-e{}-n500-free", num(e));
+        s.description = format!("head-on glass beads r = 1 mm, {tag}, LAMMPS' current Tsuji damping (the fit times sqrt(2)) of e = {e}, v = 1 m/s, dt = t_c/500, Fn clamp off");
+        out.push(Case::new(name, s, vec![Code::Lammps], true));
+    }
+    let mut s = builtin::oblique(glass(0.5), 1e-3, 1.0, 45.0, TangentialSpec::TotalForceCap, 200.0);
+    s.model.damping = DampingSpec::TsujiSqrt2;
+    s.description = "glass bead on a flat glass wall at 1 m/s, 45 deg, LAMMPS' tangential law (total_force_cap), LAMMPS' current Tsuji damping of e = 0.5, t_c/200".to_string();
+    out.push(Case::new("tsuji/sqrt2-wall-force-cap-a45".to_string(), s, vec![Code::Lammps], true));
 }
 
 /// The linear spring against LIGGGHTS (`model hooke` and `hooke/stiffness`, tangential

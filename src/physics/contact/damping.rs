@@ -73,15 +73,27 @@ pub fn tsuji_alpha<R: Real>(e: R) -> R {
 /// LAMMPS' `damping tsuji` (`model.damping = "tsuji"`): `gn = alpha(e) sqrt(m* kn)`,
 /// `gt = alpha(e) sqrt(m* kt)` with the secant stiffnesses of the normal law and
 /// [`tsuji_alpha`] of the pair's restitution. The realised restitution is not e (see
-/// [`crate::scene::DampingSpec::Tsuji`]).
+/// [`crate::scene::DampingSpec::Tsuji`]). With `SQRT2` (`model.damping =
+/// "tsuji_sqrt2"`), LAMMPS' current `damping tsuji`, which multiplies the fit by sqrt(2)
+/// "for effective mass convention (as in Tsuji 1992)" (its
+/// src/GRANULAR/gran_sub_mod_damping.cpp): under Hertz it realises the input e within
+/// 1.1e-3 ([`crate::scene::DampingSpec::TsujiSqrt2`]).
 #[derive(Clone, Copy, Debug, Default)]
-pub struct TsujiFit;
+pub struct TsujiFit<const SQRT2: bool = false>;
 
-impl Damping for TsujiFit {
-    const NAME: &'static str = "Tsuji";
+/// The factor on LAMMPS' Tsuji fit: 1 as LAMMPS 20220106 has it, sqrt(2) as its current
+/// release.
+pub fn tsuji_factor(sqrt2: bool) -> f64 {
+    if sqrt2 { std::f64::consts::SQRT_2 } else { 1.0 }
+}
+
+impl<const SQRT2: bool> Damping for TsujiFit<SQRT2> {
+    const NAME: &'static str = if SQRT2 { "Tsuji (x sqrt 2)" } else { "Tsuji" };
     #[inline(always)]
     fn coefficients<R: Real>(pm: &PairMaterial<R>, sqrt_m_star: R, st: &Stiffness<R>) -> (R, R) {
-        let c = tsuji_alpha(pm.restitution) * sqrt_m_star;
+        // LAMMPS' order: the fit, times sqrt(2) when asked, then the mass and stiffness.
+        let alpha = if SQRT2 { tsuji_alpha(pm.restitution) * k::<R>(std::f64::consts::SQRT_2) } else { tsuji_alpha(pm.restitution) };
+        let c = alpha * sqrt_m_star;
         (c * st.kn.simd_sqrt(), c * st.kt.simd_sqrt())
     }
 }

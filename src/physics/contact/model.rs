@@ -579,6 +579,14 @@ pub type HertzTsujiFrictionless = ContactModel<Hertz, TsujiFit, Frictionless>;
 pub type HertzTsujiHistory = ContactModel<Hertz, TsujiFit, TotalDisplacement>;
 pub type HookeTsujiFrictionless = ContactModel<Hooke, TsujiFit, Frictionless>;
 pub type HookeTsujiHistory = ContactModel<Hooke, TsujiFit, TotalDisplacement>;
+/// LAMMPS' current `damping tsuji` (`model.damping = "tsuji_sqrt2"`: the fit times
+/// sqrt(2)), with the same normal laws and tangential formulations.
+pub type HertzTsujiSqrt2Frictionless = ContactModel<Hertz, TsujiFit<true>, Frictionless>;
+pub type HertzTsujiSqrt2History = ContactModel<Hertz, TsujiFit<true>, TotalDisplacement>;
+pub type HertzTsujiSqrt2ForceCap = ContactModel<Hertz, TsujiFit<true>, TotalForceCap>;
+pub type HookeTsujiSqrt2Frictionless = ContactModel<Hooke, TsujiFit<true>, Frictionless>;
+pub type HookeTsujiSqrt2History = ContactModel<Hooke, TsujiFit<true>, TotalDisplacement>;
+pub type HookeTsujiSqrt2ForceCap = ContactModel<Hooke, TsujiFit<true>, TotalForceCap>;
 
 /// DMT cohesion (`materials[].work_of_adhesion` > 0) with either normal law and its
 /// restitution damping (which is 0 at e = 1), frictionless or with the total-displacement
@@ -599,4 +607,4 @@ pub type HookeHistoryEpsd2 = ContactModel<Hooke, LinearRestitution, TotalDisplac
 pub type HookeHistorySds = ContactModel<Hooke, LinearRestitution, TotalDisplacement, NoCohesion, Sds>;
 
 /// The names of the compiled combinations, for a refusal.
-pub const COMPILED: &str = "normal hertz or hooke (hooke_stiffness), each with damping (beta(e); the linear spring's constant-restitution form) or none (every e = 1), and tangential total_displacement, total_force_cap, total_force_cap_spring_kept, incremental_force or frictionless; mindlin_deresiewicz with hertz, its damping or none; damping tsuji with either normal law, total_displacement, total_force_cap or frictionless; cohesion (work_of_adhesion > 0) with either normal law, the restitution damping, total_displacement or frictionless, without limit_force; rolling (cdt, epsd2, sds) with either normal law, the restitution damping and total_displacement, without cohesion";
+pub const COMPILED: &str = "normal hertz or hooke (hooke_stiffness), each with damping (beta(e); the linear spring's constant-restitution form) or none (every e = 1), and tangential total_displacement, total_force_cap, total_force_cap_spring_kept, incremental_force or frictionless; mindlin_deresiewicz with hertz, its damping or none; damping tsuji or tsuji_sqrt2 with either normal law, total_displacement, total_force_cap or frictionless; cohesion (work_of_adhesion > 0) with either normal law, the restitution damping, total_displacement or frictionless, without limit_force; rolling (cdt, epsd2, sds) with either normal law, the restitution damping and total_displacement, without cohesion";

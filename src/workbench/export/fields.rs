@@ -320,11 +320,11 @@ pub const FIELDS: &[Field] = &[
     each(
         "model.damping",
         written("\"clamped_restitution\": coefficientRestitution of each pair the e' whose beta(e') is the pair's clamped beta (LIGGGHTS turns it back to rounding)")
-            .or_refused("\"tsuji\": LIGGGHTS 3.8's `model hertz` and `model hooke` damp with beta(e) only; it has no Tsuji fit; \"clamped_restitution\" under `model hertz` or `model hooke` with a pair's e below 0.214, whose e' is at or below 0.05 (LIGGGHTS requires 0.05 < coefficientRestitution there)"),
+            .or_refused("\"tsuji\" and \"tsuji_sqrt2\": LIGGGHTS 3.8's `model hertz` and `model hooke` damp with beta(e) only; it has no Tsuji fit; \"clamped_restitution\" under `model hertz` or `model hooke` with a pair's e below 0.214, whose e' is at or below 0.05 (LIGGGHTS requires 0.05 < coefficientRestitution there)"),
         written("\"clamped_restitution\": betan = betas = sqrt(5/6) |beta| of the clamped beta (Hertz), the spring's cn, cs from it (YADE always clamps)")
-            .or_refused("\"tsuji\": YADE's Mindlin law damps with betan, betas only; it has no Tsuji fit"),
+            .or_refused("\"tsuji\" and \"tsuji_sqrt2\": YADE's Mindlin law damps with betan, betas only; it has no Tsuji fit"),
     )
-    .in_lammps(written("\"restitution\" and \"clamped_restitution\": `damping tsuji` with the input that gives grainlab's damping of each pair (materials[].restitution and its beta); \"tsuji\": `damping tsuji` with each pair's restitution as its input, LAMMPS' own fit, and X = sqrt(kt / kn)")),
+    .in_lammps(written("\"restitution\" and \"clamped_restitution\": `damping tsuji` with the input that gives grainlab's damping of each pair (materials[].restitution and its beta); \"tsuji\": `damping tsuji` with each pair's restitution as its input, LAMMPS' own fit, and X = sqrt(kt / kn); \"tsuji_sqrt2\": `damping tsuji` with the input c whose fit equals sqrt(2) alpha(e), solved by bisection as above, and X = sqrt(kt / kn)")),
     each(
         "model.tangential",
         written("total_displacement: `pair_style gran model hertz tangential history`; frictionless: coefficientFriction 0 (Ft = 0) and `nve`")

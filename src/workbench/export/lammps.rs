@@ -103,6 +103,10 @@ fn words(scene: &Scene, pm: &PairMaterial, kns: &[f64], what: &str) -> Result<St
         // grainlab's Tsuji damping is LAMMPS' own: the restitution is its input, and the
         // tangential damping alpha sqrt(m* kt) is sqrt(kt / kn) times the normal one.
         ("tsuji", pm.restitution, (kt / normal.1).sqrt())
+    } else if scene.model.damping == DampingSpec::TsujiSqrt2 {
+        // LAMMPS' current Tsuji damping, sqrt(2) alpha(e), in 20220106's `damping tsuji`:
+        // the input whose fit gives that alpha (as the restitution damping's remap).
+        ("tsuji", tsuji_input(tsuji_alpha(pm.restitution) * std::f64::consts::SQRT_2), (kt / normal.1).sqrt())
     } else if beta == 0.0 {
         ("viscoelastic", 0.0, ratio)
     } else {
@@ -175,7 +179,7 @@ mod tests {
         if let crate::scene::Grains::List(l) = &mut s.grains {
             l[1].material = 1;
         }
-        for damping in [crate::scene::DampingSpec::Restitution, crate::scene::DampingSpec::Tsuji] {
+        for damping in [crate::scene::DampingSpec::Restitution, crate::scene::DampingSpec::Tsuji, crate::scene::DampingSpec::TsujiSqrt2] {
             s.model.damping = damping;
             let files = super::super::export_files(&s, Code::Lammps, false, &Default::default()).unwrap();
             assert!(!files[0].1.to_ascii_lowercase().contains("nan") && !files[0].1.contains("inf"), "{}", files[0].1);
@@ -211,5 +215,12 @@ mod tests {
         // The notes' example: e = 0.5 needs 0.36665136 (Hertz).
         let c = tsuji_input(5f64.sqrt() * crate::physics::material::beta(0.5).abs());
         assert!((c - 0.36665136).abs() < 1e-8, "{c}");
+        // LAMMPS' current Tsuji damping ("tsuji_sqrt2"), sqrt(2) alpha(e), in 20220106's
+        // fit: the same rounding.
+        for e in [1e-3, 0.05, 0.1, 0.3, 0.5, 0.7, 0.9, 0.99, 1.0] {
+            let alpha = tsuji_alpha(e) * std::f64::consts::SQRT_2;
+            let c = tsuji_input(alpha);
+            assert!((tsuji_alpha(c) - alpha).abs() <= 1e-14, "e = {e}: alpha {alpha}, c {c}, back {}", tsuji_alpha(c));
+        }
     }
 }
