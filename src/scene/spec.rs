@@ -467,6 +467,15 @@ impl DampingSpec {
     pub fn is_restitution(&self) -> bool {
         *self == DampingSpec::Restitution
     }
+    /// Its name in a scene file (`model.damping`).
+    pub fn name(&self) -> &'static str {
+        match self {
+            DampingSpec::Restitution => "restitution",
+            DampingSpec::ClampedRestitution => "clamped_restitution",
+            DampingSpec::Tsuji => "tsuji",
+            DampingSpec::TsujiSqrt2 => "tsuji_sqrt2",
+        }
+    }
     /// LAMMPS' Tsuji fit, either release's: its factor on the fit (1 or sqrt(2)), or None.
     pub fn tsuji(&self) -> Option<f64> {
         match self {

@@ -177,8 +177,7 @@ impl Scene {
             }
         }
         if tsuji && matches!(self.model.tangential, TangentialSpec::IncrementalForce | TangentialSpec::TotalForceCapSpringKept | TangentialSpec::MindlinDeresiewicz) {
-            let name = if self.model.damping == DampingSpec::Tsuji { "tsuji" } else { "tsuji_sqrt2" };
-            check(false, "model", "damping", name, &format!("\"restitution\" with model.tangential = {} (compiled: {})", self.model.tangential.name(), crate::physics::contact::model::COMPILED))?;
+            check(false, "model", "damping", self.model.damping.name(), &format!("\"restitution\" with model.tangential = {} (compiled: {})", self.model.tangential.name(), crate::physics::contact::model::COMPILED))?;
         }
         // DMT cohesion is compiled with the restitution damping, frictionless or with the
         // total displacement, and without the clamp (which would remove the attraction).

@@ -30,8 +30,7 @@ pub(crate) fn prepare(scene: &Scene, code: Code, limits: &crate::scene::limits::
         return Err(fields::refuse(code, "gravity", format!("[{gx}, {gy}]"), ""));
     }
     if scene.model.damping.tsuji().is_some() && code != Code::Lammps {
-        let name = if scene.model.damping == crate::scene::DampingSpec::Tsuji { "\"tsuji\"" } else { "\"tsuji_sqrt2\"" };
-        return Err(fields::refuse(code, "model.damping", name, ""));
+        return Err(fields::refuse(code, "model.damping", format!("\"{}\"", scene.model.damping.name()), ""));
     }
     if let Some((k, m)) = scene.adhesive_material()
         && (code != Code::Lammps || !scene.model.normal.is_hertz())
