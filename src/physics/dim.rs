@@ -71,6 +71,11 @@ pub trait Dim: Copy + Default + Debug + Send + Sync + 'static {
     fn cross_spin<R: Real>(a: Self::Vector<R>, w: Self::Spin<R>) -> Self::Vector<R>;
     /// No spin, no torque.
     fn spin_zero<R: Real>() -> Self::Spin<R>;
+    /// `a . b` of two spins (or a torque and a spin: a power, W).
+    fn spin_dot<R: Real>(a: Self::Spin<R>, b: Self::Spin<R>) -> R;
+    /// `c |w|^2`: with `c = I/2` (kg m^2) the rotational kinetic energy of a grain of
+    /// isotropic inertia, J (in the plane `(c w) w`, the 2D code's order).
+    fn spin_kinetic<R: Real>(c: R, w: Self::Spin<R>) -> R;
     /// A vector attached to a contact (YADE's elastic shear force) carried along as the
     /// contact frame turns during one step, to first order as YADE's `ScGeom::rotate`:
     /// `f -= f x (n_prev x n)`, then about the old normal by the pair's mean spin along
@@ -154,6 +159,14 @@ impl Dim for Plane {
         R::zero()
     }
     #[inline(always)]
+    fn spin_dot<R: Real>(a: R, b: R) -> R {
+        a * b
+    }
+    #[inline(always)]
+    fn spin_kinetic<R: Real>(c: R, w: R) -> R {
+        c * w * w
+    }
+    #[inline(always)]
     fn turn<R: Real>(f: Vector2<R>, n_prev: Vector2<R>, n: Vector2<R>, _spin_sum: (), _dt: R) -> Vector2<R> {
         // The axis n_prev x n is along z, and f - f x (s z) = f + (-f_y, f_x) s.
         let s = cross(n_prev, n);
@@ -197,6 +210,14 @@ impl Dim for Space {
     #[inline(always)]
     fn spin_zero<R: Real>() -> Vector3<R> {
         Vector3::zeros()
+    }
+    #[inline(always)]
+    fn spin_dot<R: Real>(a: Vector3<R>, b: Vector3<R>) -> R {
+        a.dot(&b)
+    }
+    #[inline(always)]
+    fn spin_kinetic<R: Real>(c: R, w: Vector3<R>) -> R {
+        c * w.norm_squared()
     }
     #[inline(always)]
     fn turn<R: Real>(f: Vector3<R>, n_prev: Vector3<R>, n: Vector3<R>, spin_sum: Vector3<R>, dt: R) -> Vector3<R> {

@@ -176,17 +176,17 @@ pub struct ContactState<R: Real = f64, D: Dim = Plane> {
 
 /// The force of one contact on grain i (grain j gets the opposite).
 #[derive(Clone, Copy, Debug, Default)]
-pub struct ContactForce {
+pub struct ContactForce<D: Dim = Plane> {
     /// Total force on i, N.
-    pub force: Vec2,
+    pub force: D::Vector<f64>,
     /// Tangential part of it, N (for the torques -a n x Ft).
-    pub tangential: Vec2,
+    pub tangential: D::Vector<f64>,
     /// Normal force Fn along n (after the clamp, if any), N.
     pub normal: f64,
     /// Normal stiffness kn, N/m (for diagnostics).
     pub kn: f64,
     /// Rolling torque on i, N m (0 without rolling resistance).
-    pub rolling: f64,
+    pub rolling: D::Spin<f64>,
 }
 
 /// What a contact remembers from step to step. Whether it is touching is kept beside
@@ -195,40 +195,41 @@ pub struct ContactForce {
 /// keeps the two parts in separate arrays, and the energy part only with the energy
 /// ledger on: the force kernel reads and writes the tangential state alone.)
 #[derive(Clone, Copy, Debug, Default)]
-pub struct ContactHistory<H, X = ()> {
+pub struct ContactHistory<H, X = (), D: Dim = Plane> {
     /// The contact law's state ([`Held`]: the tangential formulation's and the rolling
     /// resistance's).
     pub state: H,
     /// What the energy accounting carries over.
-    pub energy: EnergyMemory<f64, X>,
+    pub energy: EnergyMemory<f64, X, D>,
 }
 
 /// What a contact's energy accounting carries from one step to the next: the previous
 /// values of the terms it integrates by the trapezoid rule, and the contact's sums of
 /// the ledger's terms since they were last taken ([`crate::physics::energy`]); `X` the
 /// rolling torque's part ([`RollingEnergy`]: `()`, no room, without rolling resistance).
-/// (`R = Lanes`: of four contacts.)
+/// (`R = Lanes`: of four contacts; `D`: in the plane, the default, or in space.)
 #[derive(Clone, Copy, Debug, Default, Serialize, Deserialize)]
-pub struct EnergyMemory<R: Real = f64, X = ()> {
+#[serde(bound(serialize = "R: Serialize, X: Serialize, D::Vector<R>: Serialize", deserialize = "R: Deserialize<'de>, X: Deserialize<'de>, D::Vector<R>: Deserialize<'de>"))]
+pub struct EnergyMemory<R: Real = f64, X = (), D: Dim = Plane> {
     /// Previous normal damping force (for the trapezoidal energy integrals), N.
     pub fd_prev: R,
     /// Previous elastic tangential force, N.
-    pub fte_prev: Vector2<R>,
+    pub fte_prev: D::Vector<R>,
     /// Previous tangential damping force, N.
-    pub ftd_prev: Vector2<R>,
+    pub ftd_prev: D::Vector<R>,
     /// The ledger's terms this contact added since they were last taken, J.
     pub sums: EnergySums<R>,
     /// The rolling torque's previous value and work.
     pub rolling: X,
 }
 
-impl<X: Copy + RollingEnergy<f64>> EnergyMemory<f64, X> {
+impl<X: Copy + RollingEnergy<f64, D::Spin<f64>>, D: Dim> EnergyMemory<f64, X, D> {
     /// The memory of a contact that goes on after its sums were taken: its previous
     /// values, sums 0 (the rolling work included).
     pub fn restarted(&self) -> Self {
         let mut rolling = self.rolling;
         rolling.take();
-        EnergyMemory { sums: EnergySums::default(), rolling, ..*self }
+        EnergyMemory { fd_prev: self.fd_prev, fte_prev: self.fte_prev, ftd_prev: self.ftd_prev, sums: EnergySums::default(), rolling }
     }
 }
 
@@ -423,18 +424,18 @@ impl<N: Normal, Dm: Damping, T: Tangential<D>, C: Cohesion, Rr: Rolling<D>, D: D
 
 }
 
-impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling> ContactModel<N, Dm, T, C, Rr> {
+impl<N: Normal, Dm: Damping, T: Tangential<D>, C: Cohesion, Rr: Rolling<D>, D: Dim> ContactModel<N, Dm, T, C, Rr, D> {
     /// The force of a touching contact, updating its history; with `ENERGY`, this
     /// step's energy terms and stored energies go straight into `ledger` (the flat walls'
     /// contacts, which are few and run in one order).
     #[inline(always)]
     pub fn touch<const ENERGY: bool>(
         &self,
-        c: &ContactInput,
+        c: &ContactInput<f64, D>,
         pm: &PairMaterial,
-        h: &mut ContactHistory<Held<T, Rr>, Rr::Energy>,
+        h: &mut ContactHistory<Held<T, Rr, f64, D>, Rr::Energy, D>,
         ledger: &mut EnergyLedger,
-    ) -> ContactForce {
+    ) -> ContactForce<D> {
         let s = self.force(c, pm, &mut h.state);
         if ENERGY {
             self.energy_step(c.n, c.dt, &s, &mut h.energy);
@@ -454,16 +455,16 @@ impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling> ContactMod
     /// trapezoidal work integrals of the step added to its sums, the previous-step
     /// values moved on. No branch on the data: the same bits per lane as alone.
     #[inline(always)]
-    pub fn energy_step<R: Real, X: RollingEnergy<R>>(&self, n: Vector2<R>, dt: R, s: &ContactState<R>, h: &mut EnergyMemory<R, X>) {
+    pub fn energy_step<R: Real, X: RollingEnergy<R, D::Spin<R>>>(&self, n: D::Vector<R>, dt: R, s: &ContactState<R, D>, h: &mut EnergyMemory<R, X, D>) {
         let dc = s.vc * dt;
         let fd = s.normal - s.elastic_normal;
-        h.sums.normal_damping -= k::<R>(0.5) * (h.fd_prev + fd) * dc.dot(&n);
+        h.sums.normal_damping -= k::<R>(0.5) * (h.fd_prev + fd) * D::dot(dc, n);
         h.fd_prev = fd;
         if T::FRICTION {
             let tf = s.tangential;
-            h.sums.tangential_damping -= k::<R>(0.5) * (h.ftd_prev + tf.damping).dot(&dc);
+            h.sums.tangential_damping -= k::<R>(0.5) * D::dot(h.ftd_prev + tf.damping, dc);
             h.sums.friction += tf.slip_energy;
-            h.sums.tangential_model += tf.slip_energy + k::<R>(0.5) * (h.fte_prev + tf.elastic).dot(&dc);
+            h.sums.tangential_model += tf.slip_energy + k::<R>(0.5) * D::dot(h.fte_prev + tf.elastic, dc);
             h.fte_prev = tf.elastic;
             h.ftd_prev = tf.damping;
         }
@@ -477,8 +478,8 @@ impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling> ContactMod
     /// overlap `dn` (m) with elastic tangential force `fte` (N). Cohesion's potential is
     /// `-F0 dn`.
     #[inline(always)]
-    fn elastic(kn: f64, kt: f64, pulloff: f64, dn: f64, fte: Vec2) -> (f64, f64) {
-        let ut = if T::FRICTION && kt > 0.0 { 0.5 * fte.norm_squared() / kt } else { 0.0 };
+    fn elastic(kn: f64, kt: f64, pulloff: f64, dn: f64, fte: D::Vector<f64>) -> (f64, f64) {
+        let ut = if T::FRICTION && kt > 0.0 { 0.5 * D::norm_squared(fte) / kt } else { 0.0 };
         let un = N::energy(kn, dn);
         (if C::ON { un - pulloff * dn } else { un }, ut)
     }
@@ -489,13 +490,13 @@ impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling> ContactMod
     /// `h` (`roll`: the relative spin w_i - w_j, rad/s, for the rolling torque's work). The sums stay, for the ledger to take.
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
-    pub fn release<const ENERGY: bool>(&self, c_velocity: Vec2, n: Vec2, roll: f64, dt: f64, t: &mut Held<T, Rr>, h: &mut EnergyMemory<f64, Rr::Energy>) {
+    pub fn release<const ENERGY: bool>(&self, c_velocity: D::Vector<f64>, n: D::Vector<f64>, roll: D::Spin<f64>, dt: f64, t: &mut Held<T, Rr, f64, D>, h: &mut EnergyMemory<f64, Rr::Energy, D>) {
         if ENERGY {
             let dc = c_velocity * dt;
-            h.sums.normal_damping -= 0.5 * h.fd_prev * dc.dot(&n);
+            h.sums.normal_damping -= 0.5 * h.fd_prev * D::dot(dc, n);
             if T::FRICTION {
-                h.sums.tangential_damping -= 0.5 * h.ftd_prev.dot(&dc);
-                h.sums.tangential_model += 0.5 * h.fte_prev.dot(&dc);
+                h.sums.tangential_damping -= 0.5 * D::dot(h.ftd_prev, dc);
+                h.sums.tangential_model += 0.5 * D::dot(h.fte_prev, dc);
             }
             if Rr::ON {
                 h.rolling.release(roll, dt);
@@ -503,7 +504,7 @@ impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling> ContactMod
         }
         *t = Default::default();
         if ENERGY {
-            *h = EnergyMemory { sums: h.sums, rolling: h.rolling, ..Default::default() };
+            *h = EnergyMemory { fd_prev: 0.0, fte_prev: D::zero(), ftd_prev: D::zero(), sums: h.sums, rolling: h.rolling };
         }
     }
 }

@@ -66,7 +66,7 @@ pub trait Rolling<D: Dim = Plane>: Copy + Send + Sync + std::fmt::Debug + 'stati
     fn lane(h: &Self::History<Lanes>, l: usize) -> Self::History<f64>;
     /// What a contact's energy accounting keeps for the rolling torque (`()` without),
     /// and four contacts' of it in lanes.
-    type Energy: RollingEnergy<f64> + InLanes<Lanes: RollingEnergy<Lanes>> + PartialEq + serde::Serialize + serde::de::DeserializeOwned;
+    type Energy: RollingEnergy<f64, D::Spin<f64>> + InLanes<Lanes: RollingEnergy<Lanes, D::Spin<Lanes>>> + PartialEq + serde::Serialize + serde::de::DeserializeOwned;
     /// The torque on grain i, N m (j gets the opposite), advancing the state `h`.
     fn torque<R: Real>(&self, h: &mut Self::History<R>, inp: &RollingInput<R, D>) -> D::Spin<R>;
     /// The law and its parameters, for `explain` and checkpoints.
@@ -78,14 +78,15 @@ pub trait Rolling<D: Dim = Plane>: Copy + Send + Sync + std::fmt::Debug + 'stati
 /// The rolling torque's part of a contact's energy memory
 /// ([`crate::physics::contact::EnergyMemory`]): its previous value and the work it took
 /// from the grains since the ledger last took it. A contact without rolling resistance
-/// keeps `()`: no room, no work.
-pub trait RollingEnergy<R: Real>: Copy + Default + Send + Sync + std::fmt::Debug {
+/// keeps `()`: no room, no work. `S` is the torque's and spin's type: a number about z in
+/// the plane (the default), a vector in space ([`crate::physics::dim::Dim::Spin`]).
+pub trait RollingEnergy<R: Real, S = R>: Copy + Default + Send + Sync + std::fmt::Debug {
     /// One step of torque `m` on grain i (N m) against the relative spin `w` (rad/s) over
     /// `dt` (s): the trapezoid rule's work, as every term of the ledger.
-    fn step(&mut self, m: R, w: R, dt: R);
+    fn step(&mut self, m: S, w: S, dt: R);
     /// The contact ended over this step (the torque fell to 0): close the integral and
     /// forget the previous torque; the work stays to be taken.
-    fn release(&mut self, w: R, dt: R);
+    fn release(&mut self, w: S, dt: R);
     /// The work taken from the grains since last taken, J; left at 0.
     fn take(&mut self) -> R;
     /// The work taken, J (unchanged).
@@ -121,11 +122,11 @@ impl InLanes for RollingMemory {
     }
 }
 
-impl<R: Real> RollingEnergy<R> for () {
+impl<R: Real, S> RollingEnergy<R, S> for () {
     #[inline(always)]
-    fn step(&mut self, _: R, _: R, _: R) {}
+    fn step(&mut self, _: S, _: S, _: R) {}
     #[inline(always)]
-    fn release(&mut self, _: R, _: R) {}
+    fn release(&mut self, _: S, _: R) {}
     #[inline(always)]
     fn take(&mut self) -> R {
         R::zero()
