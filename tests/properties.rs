@@ -28,7 +28,7 @@ proptest! {
     #[test]
     fn cell_list_equals_brute_force((x, r, n_free, periodic, skin) in packing()) {
         let side = x.iter().map(|p| p.x).fold(0.0, f64::max) + 1e-9;
-        let b = if periodic { Boundary::periodic_x(0.0, side) } else { Boundary::open() };
+        let b: Boundary = if periodic { Boundary::periodic_x(0.0, side) } else { Boundary::open() };
         let brute = brute_force_pairs(&x, &r, n_free, &b, skin);
         let cells = cell_pairs(&x, &r, n_free, &b, skin, &mut Vec::new(), &mut Vec::new(), &Threads::serial());
         prop_assert_eq!(cells, brute);
@@ -50,7 +50,7 @@ proptest! {
             // Two flung grains may land together: the second next to the first.
             x[i] = if k == 1 { x[far[0].0 % x.len()] + Vec2::new(r[i], 0.0) } else { Vec2::new(side * 10f64.powf(*ex), side * 10f64.powf(*ey)) };
         }
-        let b = Boundary::open();
+        let b: Boundary = Boundary::open();
         let brute = brute_force_pairs(&x, &r, n_free, &b, skin);
         let cells = cell_pairs(&x, &r, n_free, &b, skin, &mut Vec::new(), &mut Vec::new(), &Threads::serial());
         prop_assert_eq!(cells, brute);

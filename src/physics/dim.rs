@@ -12,7 +12,7 @@
 
 use std::f64::consts::PI;
 use std::fmt::Debug;
-use std::ops::{Add, AddAssign, Mul, Neg, Sub, SubAssign};
+use std::ops::{Add, AddAssign, Index, IndexMut, Mul, Neg, Sub, SubAssign};
 
 use nalgebra::{Vector2, Vector3};
 use schemars::JsonSchema;
@@ -42,7 +42,9 @@ pub trait Dim: Copy + Default + Debug + Send + Sync + 'static {
         + Neg<Output = Self::Vector<R>>
         + Mul<R, Output = Self::Vector<R>>
         + AddAssign
-        + SubAssign;
+        + SubAssign
+        + Index<usize, Output = R>
+        + IndexMut<usize>;
     /// A spin or a torque: a number about z in the plane, a vector in space (rad/s, N m).
     type Spin<R: Real>: Copy + Default + Debug + Send + Sync + Add<Output = Self::Spin<R>> + Mul<R, Output = Self::Spin<R>>;
     /// What turns a contact about its normal: the pair's spin sum `w_i + w_j` in space
