@@ -15,7 +15,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use crate::engine::world::{PendingKick, Stage, World};
 use crate::error::Error;
 use crate::physics::contact::ContactLaw;
-use crate::physics::dim::Vec2;
+use crate::physics::dim::{Dim, Plane, Vec2};
 use crate::physics::walls::Glued;
 
 /// Give the final half kick left pending ([`crate::engine::world::KickFactors::pending`]), if any: the
@@ -102,9 +102,9 @@ impl<L: ContactLaw, const ROT: bool> Stage<L> for InitialIntegrate<ROT> {
             let part = (&mut v[from..], &mut x[from..], &mut f[from..], &dtfm2[from..]);
             let spin = (&mut omega[from..], &mut torque[from..], &dtfi[from..]);
             if twice {
-                drift_free::<ROT, true>(part, spin, dt);
+                drift_free::<Plane, ROT, true>(part, spin, dt);
             } else {
-                drift_free::<ROT, false>(part, spin, dt);
+                drift_free::<Plane, ROT, false>(part, spin, dt);
             }
             // Back into the periodic cell: rarely anyone to bring back, so one check of
             // all first (the wrap itself is a chain of roundings per grain).
@@ -137,13 +137,19 @@ impl<L: ContactLaw, const ROT: bool> Stage<L> for InitialIntegrate<ROT> {
     }
 }
 
+/// The grains' velocities, positions, forces and the kick factors of their components
+/// ([`crate::engine::world::crate::engine::world::KickFactors::dtfm2`]), in the plane or space.
+type Translation<'a, D> = (&'a mut [<D as Dim>::Vector<f64>], &'a mut [<D as Dim>::Vector<f64>], &'a mut [<D as Dim>::Vector<f64>], &'a [<D as Dim>::Vector<f64>]);
+/// The grains' spins, torques and the kick factors of their components.
+type Rotation<'a, D> = (&'a mut [<D as Dim>::Spin<f64>], &'a mut [<D as Dim>::Spin<f64>], &'a [<D as Dim>::Spin<f64>]);
+
 /// The first half kick (after the pending final one of the last step when `TWICE`) and
 /// the drift of free grains; their forces (and torques) are then used, and set to zero
-/// for the step's contacts to add to.
+/// for the step's contacts to add to. Written once for the plane and space: component
+/// by component, so the same loop for both ([`crate::engine::world::KickFactors::dtfm2`]).
 #[inline(always)]
-fn drift_free<const ROT: bool, const TWICE: bool>((v, x, f, dtfm2): (&mut [Vec2], &mut [Vec2], &mut [Vec2], &[Vec2]), (omega, torque, dtfi): (&mut [f64], &mut [f64], &[f64]), dt: f64) {
-    // Component by component ([`KickFactors::dtfm2`]).
-    let (vc, xc, fc, mc) = (flat_mut(v), flat_mut(x), flat(f), flat(dtfm2));
+pub fn drift_free<D: Dim, const ROT: bool, const TWICE: bool>((v, x, f, dtfm2): Translation<'_, D>, (omega, torque, dtfi): Rotation<'_, D>, dt: f64) {
+    let (vc, xc, fc, mc) = (D::flat_mut(v), D::flat_mut(x), D::flat(f), D::flat(dtfm2));
     for (((v, x), f), m) in vc.iter_mut().zip(xc.iter_mut()).zip(fc).zip(mc) {
         if TWICE {
             *v += *m * *f;
@@ -151,15 +157,29 @@ fn drift_free<const ROT: bool, const TWICE: bool>((v, x, f, dtfm2): (&mut [Vec2]
         *v += *m * *f;
         *x += dt * *v;
     }
-    f.fill(Vec2::zeros());
+    f.fill(D::zero());
     if ROT {
-        for ((w, t), m) in omega.iter_mut().zip(&*torque).zip(dtfi) {
+        for ((w, t), m) in D::spin_flat_mut(omega).iter_mut().zip(D::spin_flat(torque)).zip(D::spin_flat(dtfi)) {
             if TWICE {
                 *w += *m * *t;
             }
             *w += *m * *t;
         }
-        torque.fill(0.0);
+        torque.fill(D::spin_zero());
+    }
+}
+
+/// A half kick of free grains `v` (and with `ROT` their spins `omega`) from their forces
+/// `f` and torques, component by component; written once for the plane and space.
+#[inline(always)]
+pub fn kick_components<D: Dim, const ROT: bool>(v: &mut [D::Vector<f64>], f: &[D::Vector<f64>], dtfm2: &[D::Vector<f64>], (omega, torque, dtfi): (&mut [D::Spin<f64>], &[D::Spin<f64>], &[D::Spin<f64>])) {
+    for ((v, f), m) in D::flat_mut(v).iter_mut().zip(D::flat(f)).zip(D::flat(dtfm2)) {
+        *v += *m * *f;
+    }
+    if ROT {
+        for ((w, t), m) in D::spin_flat_mut(omega).iter_mut().zip(D::spin_flat(torque)).zip(D::spin_flat(dtfi)) {
+            *w += *m * *t;
+        }
     }
 }
 
@@ -173,15 +193,7 @@ fn kick_part<const ROT: bool>(v: &mut [Vec2], f: &mut [Vec2], (dtfm, dtfm2): (&[
         let _ = dtfm;
         0
     };
-    // Component by component ([`KickFactors::dtfm2`]).
-    for ((v, f), m) in flat_mut(&mut v[from..]).iter_mut().zip(flat(&f[from..])).zip(flat(&dtfm2[from..])) {
-        *v += *m * *f;
-    }
-    if ROT {
-        for ((w, t), m) in omega[from..].iter_mut().zip(&torque[from..]).zip(&dtfi[from..]) {
-            *w += *m * *t;
-        }
-    }
+    kick_components::<Plane, ROT>(&mut v[from..], &f[from..], &dtfm2[from..], (&mut omega[from..], &torque[from..], &dtfi[from..]));
 }
 
 /// The half kick of all free grains for time step `dt`, on the run's threads.
@@ -192,16 +204,6 @@ fn kick_free<L: ContactLaw, const ROT: bool>(w: &mut World<L>, dt: f64) {
     k.update(p, dt);
     let rotation = (&mut p.omega[..n], &mut p.torque[..n], &k.dtfi[..]);
     w.threads.split(n, ((&mut p.v[..n], &mut p.f[..n], (&k.dtfm[..], &k.dtfm2[..])), rotation), |((v, f, dtfm), (omega, torque, dtfi))| kick_part::<ROT>(v, f, dtfm, omega, torque, dtfi));
-}
-
-/// The components of vectors `v`, as they are stored: x, y, x, y, ...
-fn flat(v: &[Vec2]) -> &[f64] {
-    bytemuck::cast_slice(v)
-}
-
-/// The components of vectors `v`, as they are stored: x, y, x, y, ...
-fn flat_mut(v: &mut [Vec2]) -> &mut [f64] {
-    bytemuck::cast_slice_mut(v)
 }
 
 /// Second half kick of the free grains, or left to the next drift when nothing looks at

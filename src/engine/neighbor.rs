@@ -5,15 +5,15 @@
 use crate::kernels::cells::cell_pairs;
 use crate::kernels::threads::Threads;
 use crate::physics::boundary::Boundary;
-use crate::physics::dim::Vec2;
+use crate::physics::dim::{Dim, Plane};
 
-/// Cell-list builder and the skin bookkeeping.
+/// Cell-list builder and the skin bookkeeping, in the plane (the default `D`) or space.
 #[derive(Clone, Debug)]
-pub struct Neighbours {
+pub struct Neighbours<D: Dim = Plane> {
     /// Skin, m.
     pub skin: f64,
     /// Positions at the last build.
-    x_at_build: Vec<Vec2>,
+    x_at_build: Vec<D::Vector<f64>>,
     /// Number of builds so far.
     pub builds: u64,
     cell_start: Vec<u32>,
@@ -23,7 +23,7 @@ pub struct Neighbours {
     pub moved_far: bool,
 }
 
-impl Neighbours {
+impl<D: Dim> Neighbours<D> {
     pub fn new(skin: f64) -> Self {
         Neighbours { skin, x_at_build: Vec::new(), builds: 0, cell_start: Vec::new(), cell_items: Vec::new(), moved_far: false }
     }
@@ -35,7 +35,7 @@ impl Neighbours {
     }
 
     /// Positions at the last build (empty before the first).
-    pub fn at_build(&self) -> &[Vec2] {
+    pub fn at_build(&self) -> &[D::Vector<f64>] {
         &self.x_at_build
     }
 
@@ -48,14 +48,14 @@ impl Neighbours {
 
     /// Take the state a checkpoint saved: the positions at the last build, the number of
     /// builds, and whether a grain has moved far since ([`crate::engine::snapshot`]).
-    pub fn restore(&mut self, at_build: Vec<Vec2>, builds: u64, moved_far: bool) {
+    pub fn restore(&mut self, at_build: Vec<D::Vector<f64>>, builds: u64, moved_far: bool) {
         self.x_at_build = at_build;
         self.builds = builds;
         self.moved_far = moved_far;
     }
 
     /// Build the pair list with the cell list.
-    pub fn build(&mut self, x: &[Vec2], r: &[f64], n_free: usize, boundary: &Boundary, threads: &Threads) -> Vec<[u32; 2]> {
+    pub fn build(&mut self, x: &[D::Vector<f64>], r: &[f64], n_free: usize, boundary: &Boundary<D>, threads: &Threads) -> Vec<[u32; 2]> {
         self.builds += 1;
         self.moved_far = false;
         self.x_at_build.clear();

@@ -10,7 +10,7 @@ use crate::physics::boundary::Boundary;
 use crate::physics::contact::model::Held;
 use crate::physics::contact::rolling::Rolling;
 use crate::physics::contact::{ContactHistory, ContactLaw, ContactRecord};
-use crate::physics::dim::Vec2;
+use crate::physics::dim::{Dim, Plane, Vec2};
 use crate::physics::energy::{EnergyLedger, EnergyRow};
 use crate::physics::material::PairTable;
 use crate::physics::particles::Particles;
@@ -285,17 +285,17 @@ pub trait Stage<L: ContactLaw>: Send {
 /// LIGGGHTS' `dtfm = dtf / rmass[i]`). One set per world (`World::kick`), shared by both
 /// half kicks.
 #[derive(Default)]
-pub struct KickFactors {
+pub struct KickFactors<D: Dim = Plane> {
     dt: f64,
     /// dt/2 / m, s/kg.
     pub dtfm: Vec<f64>,
-    /// dt/2 / m twice per grain, s/kg: the factor of each component of a grain's
-    /// velocity, as the velocities are stored (x, y). A kick or drift over the
-    /// components is then element by element, which compilers vectorise without
-    /// splitting the (x, y) pairs into an x and a y register and back.
-    pub dtfm2: Vec<Vec2>,
-    /// dt/2 / I, s/(kg m^2).
-    pub dtfi: Vec<f64>,
+    /// dt/2 / m for each component of a grain's velocity (2 or 3 per grain), s/kg, as
+    /// the velocities are stored (x, y, ...). A kick or drift over the components is
+    /// then element by element, which compilers vectorise without splitting the vectors
+    /// into an x and a y register and back.
+    pub dtfm2: Vec<D::Vector<f64>>,
+    /// dt/2 / I for each component of a grain's spin (one in the plane), s/(kg m^2).
+    pub dtfi: Vec<D::Spin<f64>>,
     /// Leave this step's final half kick to the next drift: nothing looks at the grains'
     /// velocities before it ([`crate::engine::simulation::Simulation::advance`] sets it).
     pub defer: bool,
@@ -314,16 +314,16 @@ pub struct PendingKick {
     pub spin: bool,
 }
 
-impl KickFactors {
+impl<D: Dim> KickFactors<D> {
     /// Recompute for time step `dt` if it (or the number of free grains) changed.
-    pub fn update(&mut self, p: &Particles, dt: f64) {
+    pub fn update(&mut self, p: &Particles<D>, dt: f64) {
         let n = p.n_free;
         if self.dt != dt || self.dtfm.len() != n {
             let dtf = 0.5 * dt;
             self.dt = dt;
             self.dtfm = p.m[..n].iter().map(|m| dtf / m).collect();
-            self.dtfm2 = self.dtfm.iter().map(|&m| Vec2::new(m, m)).collect();
-            self.dtfi = p.inertia[..n].iter().map(|i| dtf / i).collect();
+            self.dtfm2 = self.dtfm.iter().map(|&m| D::splat(m)).collect();
+            self.dtfi = p.inertia[..n].iter().map(|i| D::spin_splat(dtf / i)).collect();
         }
     }
 }

@@ -78,6 +78,17 @@ pub trait Dim: Copy + Default + Debug + Send + Sync + 'static {
     /// `c |w|^2`: with `c = I/2` (kg m^2) the rotational kinetic energy of a grain of
     /// isotropic inertia, J (in the plane `(c w) w`, the 2D code's order).
     fn spin_kinetic<R: Real>(c: R, w: Self::Spin<R>) -> R;
+    /// A vector with every component `c` (a per-component factor of the integrator).
+    fn splat(c: f64) -> Self::Vector<f64>;
+    /// A spin with every component `c`.
+    fn spin_splat(c: f64) -> Self::Spin<f64>;
+    /// The components of vectors as they are stored (x, y, x, y, ... or x, y, z, ...):
+    /// loops over them vectorise without splitting a vector into registers and back.
+    fn flat(v: &[Self::Vector<f64>]) -> &[f64];
+    fn flat_mut(v: &mut [Self::Vector<f64>]) -> &mut [f64];
+    /// The components of spins as they are stored.
+    fn spin_flat(w: &[Self::Spin<f64>]) -> &[f64];
+    fn spin_flat_mut(w: &mut [Self::Spin<f64>]) -> &mut [f64];
     /// A vector attached to a contact (YADE's elastic shear force) carried along as the
     /// contact frame turns during one step, to first order as YADE's `ScGeom::rotate`:
     /// `f -= f x (n_prev x n)`, then about the old normal by the pair's mean spin along
@@ -117,6 +128,18 @@ macro_rules! nalgebra_vector {
         }
         fn save(v: $v<f64>) -> $v<f64> {
             v
+        }
+        #[inline(always)]
+        fn splat(c: f64) -> $v<f64> {
+            $v::repeat(c)
+        }
+        #[inline(always)]
+        fn flat(v: &[$v<f64>]) -> &[f64] {
+            bytemuck::cast_slice(v)
+        }
+        #[inline(always)]
+        fn flat_mut(v: &mut [$v<f64>]) -> &mut [f64] {
+            bytemuck::cast_slice_mut(v)
         }
         fn load(s: $v<f64>) -> $v<f64> {
             s
@@ -167,6 +190,18 @@ impl Dim for Plane {
     #[inline(always)]
     fn spin_kinetic<R: Real>(c: R, w: R) -> R {
         c * w * w
+    }
+    #[inline(always)]
+    fn spin_splat(c: f64) -> f64 {
+        c
+    }
+    #[inline(always)]
+    fn spin_flat(w: &[f64]) -> &[f64] {
+        w
+    }
+    #[inline(always)]
+    fn spin_flat_mut(w: &mut [f64]) -> &mut [f64] {
+        w
     }
     #[inline(always)]
     fn turn<R: Real>(f: Vector2<R>, n_prev: Vector2<R>, n: Vector2<R>, _spin_sum: (), _dt: R) -> Vector2<R> {
@@ -220,6 +255,18 @@ impl Dim for Space {
     #[inline(always)]
     fn spin_kinetic<R: Real>(c: R, w: Vector3<R>) -> R {
         c * w.norm_squared()
+    }
+    #[inline(always)]
+    fn spin_splat(c: f64) -> Vector3<f64> {
+        Vector3::repeat(c)
+    }
+    #[inline(always)]
+    fn spin_flat(w: &[Vector3<f64>]) -> &[f64] {
+        bytemuck::cast_slice(w)
+    }
+    #[inline(always)]
+    fn spin_flat_mut(w: &mut [Vector3<f64>]) -> &mut [f64] {
+        bytemuck::cast_slice_mut(w)
     }
     #[inline(always)]
     fn turn<R: Real>(f: Vector3<R>, n_prev: Vector3<R>, n: Vector3<R>, spin_sum: Vector3<R>, dt: R) -> Vector3<R> {

@@ -7,7 +7,7 @@
 
 use std::ops::Range;
 
-use crate::physics::dim::Vec2;
+use crate::physics::dim::{Dim, Plane};
 
 /// What the grains touch.
 #[derive(Clone, Debug, PartialEq)]
@@ -27,8 +27,10 @@ pub enum Control {
     Load { force: f64 },
 }
 
+/// A wall of a world in the plane (the default `D`) or in space: in both it is normal
+/// to y, and slides in the plane it lies in.
 #[derive(Clone, Debug)]
-pub struct Wall {
+pub struct Wall<D: Dim = Plane> {
     /// "bottom" or "top".
     pub name: &'static str,
     pub surface: Surface,
@@ -40,8 +42,8 @@ pub struct Wall {
     pub y: f64,
     /// Displacement in x since the start, m.
     pub x_shift: f64,
-    /// Velocity, m/s: x prescribed, y from the load (or 0).
-    pub v: Vec2,
+    /// Velocity, m/s: x (and z) prescribed, y from the load (or 0).
+    pub v: D::Vector<f64>,
     /// Mass that the load accelerates, kg.
     pub mass: f64,
     /// Radius of a rough wall's glued grains (its contact surface lies this far from `y`
@@ -51,12 +53,12 @@ pub struct Wall {
     /// grain's; a rough wall's glued grains carry it themselves).
     pub material: usize,
     /// Force of the grains on the wall at this step, N.
-    pub force: Vec2,
+    pub force: D::Vector<f64>,
     /// ... and at the previous step.
-    pub force_prev: Vec2,
+    pub force_prev: D::Vector<f64>,
 }
 
-impl Wall {
+impl<D: Dim> Wall<D> {
     /// The external force along y on the wall from its load, N.
     pub fn load_y(&self) -> f64 {
         match self.control {
@@ -68,7 +70,7 @@ impl Wall {
     pub fn kinetic(&self) -> f64 {
         match self.control {
             Control::Fixed => 0.0,
-            Control::Load { .. } => 0.5 * self.mass * self.v.y * self.v.y,
+            Control::Load { .. } => 0.5 * self.mass * self.v[1] * self.v[1],
         }
     }
     pub fn is_flat(&self) -> bool {
@@ -82,20 +84,20 @@ impl Wall {
 }
 
 /// A rough wall's grains and their rigid move this step.
-pub struct Glued {
+pub struct Glued<D: Dim = Plane> {
     /// The grains (indices into the particle arrays).
     pub grains: std::ops::Range<usize>,
     /// Displacement this step, m.
-    pub d: Vec2,
+    pub d: D::Vector<f64>,
     /// Velocity, m/s.
-    pub v: Vec2,
+    pub v: D::Vector<f64>,
 }
 
-impl Glued {
+impl<D: Dim> Glued<D> {
     /// The grains of `wall` if it is rough, and its move over `dt` at its velocity now (the
     /// product [`crate::engine::stages::MoveWalls`] moved the wall by, so the grains keep their
     /// place on it to the bit).
-    pub fn of(wall: &Wall, dt: f64) -> Option<Glued> {
+    pub fn of(wall: &Wall<D>, dt: f64) -> Option<Glued<D>> {
         match &wall.surface {
             Surface::Rough { grains } => Some(Glued { grains: grains.clone(), d: wall.v * dt, v: wall.v }),
             Surface::Flat => None,
@@ -105,7 +107,7 @@ impl Glued {
     /// Move grains `x` (some of this wall's, with their velocities `v` and positions `at`
     /// at the neighbour list's build) with the wall, back into the periodic cell; whether
     /// one has moved more than `limit` (squared) since the build.
-    pub fn follow(&self, x: &mut [Vec2], v: &mut [Vec2], at: &[Vec2], b: &crate::physics::boundary::Boundary, limit: f64) -> bool {
+    pub fn follow(&self, x: &mut [D::Vector<f64>], v: &mut [D::Vector<f64>], at: &[D::Vector<f64>], b: &crate::physics::boundary::Boundary<D>, limit: f64) -> bool {
         // As slices, so that the loops vectorise; and the wrap (a chain of roundings per
         // grain) only when a grain has left the cell, which leaves the same bits as
         // wrapping every grain (`Boundary::wrap` keeps the bits of a grain inside).
