@@ -51,7 +51,7 @@ use crate::physics::contact::rolling::Rolling;
 use crate::physics::contact::damping::Damping;
 use crate::physics::contact::normal::Normal;
 use crate::physics::contact::tangential::Tangential;
-use crate::physics::dim::Vec2;
+use crate::physics::dim::{Plane, Vec2};
 use std::sync::OnceLock;
 use std::time::{Duration, Instant};
 
@@ -443,7 +443,7 @@ impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling, const ENER
                         }
                         cross_out[slot] = o;
                     };
-                    compute_pairs::<N, Dm, T, C, Rr, ENERGY, SPIN>(&view, list, &touching[..nt], &sep[..nt], &released[..nr], sink);
+                    compute_pairs::<N, Dm, T, C, Rr, Plane, ENERGY, SPIN>(&view, list, &touching[..nt], &sep[..nt], &released[..nr], sink);
                 }
                 let own_cross: &[PairOut] = cross_out;
                 let _ = published[r].set(own_cross);
@@ -492,7 +492,7 @@ impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling, const ENER
                     }
                 };
                 let sink = |_, ij: (usize, usize), o: PairOut| add(ij, &o, true);
-                let (ratio, kk) = compute_pairs::<N, Dm, T, C, Rr, ENERGY, SPIN>(&view, list, &touching[..nt], &sep[..nt], &released[..nr], sink);
+                let (ratio, kk) = compute_pairs::<N, Dm, T, C, Rr, Plane, ENERGY, SPIN>(&view, list, &touching[..nt], &sep[..nt], &released[..nr], sink);
                 let mut best = if kk == usize::MAX { (0.0, usize::MAX) } else { (ratio, part.start + kk) };
                 // (5) Our cross pairs' forces on our grains: a grain's pairs (g, j) with j in
                 // a later range are the last of its sequence.

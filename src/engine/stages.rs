@@ -15,7 +15,7 @@ use crate::physics::contact::damping::Damping;
 use crate::physics::contact::normal::Normal;
 use crate::physics::contact::tangential::Tangential;
 use crate::physics::contact::{ContactInput, ContactLaw, ContactModel, ContactRecord, Partner};
-use crate::physics::dim::{Vec2, cross};
+use crate::physics::dim::{Plane, Vec2, cross};
 use crate::physics::walls::{Control, Surface};
 
 pub use crate::engine::world::Stage;
@@ -206,7 +206,7 @@ impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling, const ENER
                 ts[j] -= o.torque[1];
             }
         };
-        let (ratio, k) = compute_pairs::<N, Dm, T, C, Rr, ENERGY, SPIN>(&view, list, touching, sep, released, sink);
+        let (ratio, k) = compute_pairs::<N, Dm, T, C, Rr, Plane, ENERGY, SPIN>(&view, list, touching, sep, released, sink);
         if ratio > worst.0 {
             let [i, j] = pairs.pairs()[k];
             worst = (ratio, i as usize, j as usize);

@@ -5,7 +5,6 @@
 //! ([`PairView`]) and the list's slices ([`PairSlices`]): no World, no Engine. Uses
 //! physics and the pair list.
 
-use nalgebra::Vector2;
 use simba::simd::{SimdBool, SimdPartialOrd, SimdValue};
 use crate::kernels::pairs::{CheckedPairs, PairConst};
 use crate::physics::boundary::Boundary;
@@ -16,19 +15,19 @@ use crate::physics::contact::normal::Normal;
 use crate::physics::contact::tangential::Tangential;
 use crate::physics::contact::model::ContactState;
 use crate::physics::contact::model::Held;
-use crate::physics::contact::{ContactInput, ContactLaw, ContactModel, ContactRecord, EnergyMemory, LeverArm, Partner};
-use crate::physics::dim::{Vec2, cross};
-use crate::physics::lanes::{LANES, Lanes, Real, gather, gather2, lane2};
+use crate::physics::contact::{ContactInput, ContactModel, ContactRecord, EnergyMemory, LeverArm, Partner};
+use crate::physics::dim::{Dim, Plane};
+use crate::physics::lanes::{LANES, Lanes, Real, gather};
 use crate::physics::material::PairMaterial;
 use crate::physics::particles::Particles;
 
 /// What one grain-grain pair did this step, for the grains to collect.
 #[derive(Clone, Copy, Debug, Default)]
-pub struct PairOut {
+pub struct PairOut<D: Dim = Plane> {
     /// Force on the first grain (the second gets the opposite), N.
-    pub force: Vec2,
+    pub force: D::Vector<f64>,
     /// Torques to subtract from the first and the second grain, N m.
-    pub torque: [f64; 2],
+    pub torque: [D::Spin<f64>; 2],
     /// Overlap over the smaller radius (0 when not touching).
     pub ratio: f64,
 }
@@ -38,23 +37,24 @@ pub struct PairOut {
 /// rotate), relative velocity and constants.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-fn pair_input<R: Real, T: Tangential, Rr: Rolling, const SPIN: bool>(lever: LeverArm, d: Vector2<R>, ri: R, rj: R, wi: R, wj: R, v_rel: Vector2<R>, r_star: R, sqrt_m_star: R, dt: R) -> ContactInput<R> {
+fn pair_input<R: Real, D: Dim, T: Tangential<D>, Rr: Rolling<D>, const SPIN: bool>(lever: LeverArm, d: D::Vector<R>, ri: R, rj: R, wi: D::Spin<R>, wj: D::Spin<R>, v_rel: D::Vector<R>, r_star: R, sqrt_m_star: R, dt: R) -> ContactInput<R, D> {
     let radsum = ri + rj;
-    let r = d.norm_squared().simd_sqrt();
+    let r = D::norm_squared(d).simd_sqrt();
     let n = d * r.simd_recip();
     let dn = radsum - r;
-    let spin = if T::FRICTION && SPIN { lever.arm(ri, dn) * wi + lever.arm(rj, dn) * wj } else { R::zero() };
+    let spin = if T::FRICTION && SPIN { wi * lever.arm(ri, dn) + wj * lever.arm(rj, dn) } else { D::spin_zero() };
     let tangential_scale = if T::FRICTION { lever.translation_scale(radsum, dn) } else { R::one() };
-    let roll = if Rr::ON && SPIN { wi - wj } else { R::zero() };
-    ContactInput { n, dn, r_star, sqrt_m_star, v_rel, spin, dt, tangential_scale, roll, roll_scale: R::one(), twist: () }
+    let roll = if Rr::ON && SPIN { wi - wj } else { D::spin_zero() };
+    let twist = if T::FRICTION && SPIN { D::twist(wi + wj) } else { D::twist(D::spin_zero()) };
+    ContactInput { n, dn, r_star, sqrt_m_star, v_rel, spin, dt, tangential_scale, roll, roll_scale: R::one(), twist }
 }
 
 /// The torques to subtract from grains i and j: `-a n x Ft` and, with rolling
 /// resistance, the rolling torque `rolling` on i (its opposite on j).
 #[inline(always)]
-fn pair_torque<R: Real, Rr: Rolling>(lever: LeverArm, c: &ContactInput<R>, ft: Vector2<R>, rolling: R, ri: R, rj: R) -> [R; 2] {
-    let t = cross(c.n, ft);
-    let (ti, tj) = (lever.torque_arm(ri, c.dn) * t, lever.torque_arm(rj, c.dn) * t);
+fn pair_torque<R: Real, D: Dim, Rr: Rolling<D>>(lever: LeverArm, c: &ContactInput<R, D>, ft: D::Vector<R>, rolling: D::Spin<R>, ri: R, rj: R) -> [D::Spin<R>; 2] {
+    let t = D::cross(c.n, ft);
+    let (ti, tj) = (t * lever.torque_arm(ri, c.dn), t * lever.torque_arm(rj, c.dn));
     if Rr::ON { [ti - rolling, tj + rolling] } else { [ti, tj] }
 }
 
@@ -62,33 +62,33 @@ fn pair_torque<R: Real, Rr: Rolling>(lever: LeverArm, c: &ContactInput<R>, ft: V
 /// (released), or nothing; tangential state `h` and (with `ENERGY`) energy memory `e`
 /// updated.
 #[inline(always)]
-pub fn pair_contact<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling, const ENERGY: bool>(
-    w: &PairView<'_, ContactModel<N, Dm, T, C, Rr>>,
+pub fn pair_contact<N: Normal, Dm: Damping, T: Tangential<D>, C: Cohesion, Rr: Rolling<D>, D: Dim, const ENERGY: bool>(
+    w: &PairView<'_, ContactModel<N, Dm, T, C, Rr, D>, D>,
     pair: [u32; 2],
     pc: &PairConst,
-    h: &mut Held<T, Rr>,
-    e: &mut EnergyMemory<f64, Rr::Energy>,
+    h: &mut Held<T, Rr, f64, D>,
+    e: &mut EnergyMemory<f64, Rr::Energy, D>,
     active: &mut bool,
-) -> PairOut {
+) -> PairOut<D> {
     let model = w.law;
     let p = w.p;
     let (i, j) = (pair[0] as usize, pair[1] as usize);
     let d = w.boundary.image(p.x[i] - p.x[j]);
-    let rsq = d.norm_squared();
+    let rsq = D::norm_squared(d);
     let (ri, rj) = (p.r[i], p.r[j]);
     let radsum = ri + rj;
     if rsq >= radsum * radsum {
         if *active {
             let n = d / rsq.sqrt();
-            let spin = if T::FRICTION { ri * p.omega[i] + rj * p.omega[j] } else { 0.0 };
-            let vc = p.v[i] - p.v[j] + spin * Vec2::new(n.y, -n.x);
-            let roll = if Rr::ON { p.omega[i] - p.omega[j] } else { 0.0 };
+            let spin = if T::FRICTION { p.omega[i] * ri + p.omega[j] * rj } else { D::spin_zero() };
+            let vc = p.v[i] - p.v[j] + D::cross_spin(n, spin);
+            let roll = if Rr::ON { p.omega[i] - p.omega[j] } else { D::spin_zero() };
             model.release::<ENERGY>(vc, n, roll, w.dt, h, e);
             *active = false;
         }
         return PairOut::default();
     }
-    let (o, n, state) = one_pair::<N, Dm, T, C, Rr, true>(w, (i, j), d, pc, h, active);
+    let (o, n, state) = one_pair::<N, Dm, T, C, Rr, D, true>(w, (i, j), d, pc, h, active);
     if ENERGY {
         model.energy_step(n, w.dt, &state, e);
     }
@@ -102,13 +102,13 @@ pub fn pair_contact<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Roll
 /// (grains that do not rotate) the spins are not read and the torques not computed.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-fn four_pairs<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling, const ENERGY: bool, const SPIN: bool>(
-    w: &PairView<'_, ContactModel<N, Dm, T, C, Rr>>,
-    list: PairSlices<'_, T, Rr>,
+fn four_pairs<N: Normal, Dm: Damping, T: Tangential<D>, C: Cohesion, Rr: Rolling<D>, D: Dim, const ENERGY: bool, const SPIN: bool>(
+    w: &PairView<'_, ContactModel<N, Dm, T, C, Rr, D>, D>,
+    list: PairSlices<'_, T, Rr, D>,
     single: Option<&PairMaterial<Lanes>>,
     ks: &[u32],
-    ds: &[Vec2],
-    sink: &mut impl FnMut(usize, (usize, usize), PairOut),
+    ds: &[D::Vector<f64>],
+    sink: &mut impl FnMut(usize, (usize, usize), PairOut<D>),
     best: &mut (f64, usize),
 ) {
     let (model, p) = (w.law, w.p);
@@ -124,20 +124,20 @@ fn four_pairs<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling, c
         (q[0] as usize, q[1] as usize)
     });
     let pc: [&PairConst; LANES] = std::array::from_fn(|l| &consts[ks[l]]);
-    let d = gather2(|l| ds[l]);
+    let d = D::gather(|l| ds[l]);
     let rs: [(f64, f64); LANES] = std::array::from_fn(|l| r.at(ks[l]));
     let (ri, rj) = (gather(|l| rs[l].0), gather(|l| rs[l].1));
     let (wi, wj) = if T::FRICTION && SPIN {
-        let ws: [(f64, f64); LANES] = std::array::from_fn(|l| omega.at(ks[l]));
-        (gather(|l| ws[l].0), gather(|l| ws[l].1))
+        let ws: [(D::Spin<f64>, D::Spin<f64>); LANES] = std::array::from_fn(|l| omega.at(ks[l]));
+        (D::gather_spin(|l| ws[l].0), D::gather_spin(|l| ws[l].1))
     } else {
-        (Lanes::splat(0.0), Lanes::splat(0.0))
+        (D::spin_zero(), D::spin_zero())
     };
-    let v_rel = gather2(|l| {
+    let v_rel = D::gather(|l| {
         let (vi, vj) = v.at(ks[l]);
         vi - vj
     });
-    let input = pair_input::<Lanes, T, Rr, SPIN>(lever, d, ri, rj, wi, wj, v_rel, gather(|l| pc[l].r_star), gather(|l| pc[l].sqrt_m_star), Lanes::splat(w.dt));
+    let input = pair_input::<Lanes, D, T, Rr, SPIN>(lever, d, ri, rj, wi, wj, v_rel, gather(|l| pc[l].r_star), gather(|l| pc[l].sqrt_m_star), Lanes::splat(w.dt));
     let pm = match single {
         Some(pm) => *pm,
         None => {
@@ -148,9 +148,9 @@ fn four_pairs<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling, c
             }))
         }
     };
-    let mut h = ContactModel::<N, Dm, T, C, Rr>::gather(std::array::from_fn(|l| &hist[ks[l]]));
+    let mut h = ContactModel::<N, Dm, T, C, Rr, D>::gather(std::array::from_fn(|l| &hist[ks[l]]));
     let c = model.force(&input, &pm, &mut h);
-    let torque = if T::FRICTION && SPIN { pair_torque::<_, Rr>(lever, &input, c.tangential.elastic + c.tangential.damping, c.rolling, ri, rj) } else { [Lanes::splat(0.0); 2] };
+    let torque = if T::FRICTION && SPIN { pair_torque::<_, D, Rr>(lever, &input, c.tangential.elastic + c.tangential.damping, c.rolling, ri, rj) } else { [D::spin_zero(); 2] };
     let ratio = input.dn * gather(|l| pc[l].inv_r_min);
     // The largest overlap so far: a lane beats it rarely, so one test per four pairs.
     let beats = ratio.simd_gt(Lanes::splat(best.0)).bitmask();
@@ -163,16 +163,16 @@ fn four_pairs<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling, c
     }
     // With the ledger, the energy memories too, in lanes.
     if ENERGY {
-        let mut e = ContactModel::<N, Dm, T, C, Rr>::gather_energy(std::array::from_fn(|l| &list.energy[ks[l]]), T::FRICTION);
+        let mut e = ContactModel::<N, Dm, T, C, Rr, D>::gather_energy(std::array::from_fn(|l| &list.energy[ks[l]]), T::FRICTION);
         model.energy_step(input.n, input.dt, &c, &mut e);
         for (l, &k) in ks.iter().enumerate() {
-            ContactModel::<N, Dm, T, C, Rr>::store_energy_lane(&e, l, &mut list.energy[k], T::FRICTION);
+            ContactModel::<N, Dm, T, C, Rr, D>::store_energy_lane(&e, l, &mut list.energy[k], T::FRICTION);
         }
     }
     for l in 0..LANES {
-        hist[ks[l]] = ContactModel::<N, Dm, T, C, Rr>::lane(&h, l);
+        hist[ks[l]] = ContactModel::<N, Dm, T, C, Rr, D>::lane(&h, l);
         active[ks[l]] = true;
-        sink(ks[l], ij[l], PairOut { force: lane2(&c.force, l), torque: [torque[0].extract(l), torque[1].extract(l)], ratio: ratio.extract(l) });
+        sink(ks[l], ij[l], PairOut { force: D::lane(&c.force, l), torque: [D::spin_lane(&torque[0], l), D::spin_lane(&torque[1], l)], ratio: ratio.extract(l) });
     }
 }
 
@@ -180,21 +180,21 @@ fn four_pairs<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling, c
 /// its output, advancing its tangential state `h`, and what its energy accounting needs
 /// (the normal and the step's contact state).
 #[inline(always)]
-fn one_pair<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling, const SPIN: bool>(
-    w: &PairView<'_, ContactModel<N, Dm, T, C, Rr>>,
+fn one_pair<N: Normal, Dm: Damping, T: Tangential<D>, C: Cohesion, Rr: Rolling<D>, D: Dim, const SPIN: bool>(
+    w: &PairView<'_, ContactModel<N, Dm, T, C, Rr, D>, D>,
     (i, j): (usize, usize),
-    d: Vec2,
+    d: D::Vector<f64>,
     pc: &PairConst,
-    h: &mut Held<T, Rr>,
+    h: &mut Held<T, Rr, f64, D>,
     active: &mut bool,
-) -> (PairOut, Vec2, ContactState) {
+) -> (PairOut<D>, D::Vector<f64>, ContactState<f64, D>) {
     let (model, p) = (w.law, w.p);
     let lever = model.options.lever_arm;
-    let input = pair_input::<f64, T, Rr, SPIN>(lever, d, p.r[i], p.r[j], p.omega[i], p.omega[j], p.v[i] - p.v[j], pc.r_star, pc.sqrt_m_star, w.dt);
+    let input = pair_input::<f64, D, T, Rr, SPIN>(lever, d, p.r[i], p.r[j], p.omega[i], p.omega[j], p.v[i] - p.v[j], pc.r_star, pc.sqrt_m_star, w.dt);
     let pm = w.pair_table.get(p.material[i] as usize, p.material[j] as usize);
     let c = model.force(&input, pm, h);
     *active = true;
-    let torque = if T::FRICTION && SPIN { pair_torque::<_, Rr>(lever, &input, c.tangential.elastic + c.tangential.damping, c.rolling, p.r[i], p.r[j]) } else { [0.0, 0.0] };
+    let torque = if T::FRICTION && SPIN { pair_torque::<_, D, Rr>(lever, &input, c.tangential.elastic + c.tangential.damping, c.rolling, p.r[i], p.r[j]) } else { [D::spin_zero(); 2] };
     (PairOut { force: c.force, torque, ratio: input.dn * pc.inv_r_min }, input.n, c)
 }
 
@@ -210,7 +210,7 @@ pub fn record_pair<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolli
         return None;
     }
     let (mut h, mut active) = (*h, true);
-    let (_, n, c) = one_pair::<N, Dm, T, C, Rr, SPIN>(w, (i, j), d, pc, &mut h, &mut active);
+    let (_, n, c) = one_pair::<N, Dm, T, C, Rr, Plane, SPIN>(w, (i, j), d, pc, &mut h, &mut active);
     let dn = ri + rj - d.norm();
     Some(ContactRecord {
         i: i as u32,
@@ -228,11 +228,11 @@ pub fn record_pair<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolli
 
 /// A part of the pair list: the pairs, their constants, tangential states, energy
 /// memories (empty without the energy ledger) and touching flags.
-pub struct PairSlices<'a, T: Tangential, Rr: Rolling> {
+pub struct PairSlices<'a, T: Tangential<D>, Rr: Rolling<D>, D: Dim = Plane> {
     pub pairs: CheckedPairs<'a>,
     pub consts: &'a [PairConst],
-    pub hist: &'a mut [Held<T, Rr>],
-    pub energy: &'a mut [EnergyMemory<f64, Rr::Energy>],
+    pub hist: &'a mut [Held<T, Rr, f64, D>],
+    pub energy: &'a mut [EnergyMemory<f64, Rr::Energy, D>],
     pub active: &'a mut [bool],
 }
 
@@ -244,13 +244,13 @@ pub struct PairSlices<'a, T: Tangential, Rr: Rolling> {
 /// them for the ledger. Returns the largest overlap over the smaller radius of the
 /// touching pairs and the index (in the part) of the first pair that has it,
 /// `(0, usize::MAX)` if none touches.
-pub fn compute_pairs<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling, const ENERGY: bool, const SPIN: bool>(
-    w: &PairView<'_, ContactModel<N, Dm, T, C, Rr>>,
-    list: PairSlices<'_, T, Rr>,
+pub fn compute_pairs<N: Normal, Dm: Damping, T: Tangential<D>, C: Cohesion, Rr: Rolling<D>, D: Dim, const ENERGY: bool, const SPIN: bool>(
+    w: &PairView<'_, ContactModel<N, Dm, T, C, Rr, D>, D>,
+    list: PairSlices<'_, T, Rr, D>,
     touching: &[u32],
-    sep: &[Vec2],
+    sep: &[D::Vector<f64>],
     released: &[u32],
-    mut sink: impl FnMut(usize, (usize, usize), PairOut),
+    mut sink: impl FnMut(usize, (usize, usize), PairOut<D>),
 ) -> (f64, usize) {
     let mut best = (0.0, usize::MAX);
     let quads = touching.len() / LANES * LANES;
@@ -258,13 +258,13 @@ pub fn compute_pairs<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rol
     let single = w.pair_table.single().map(|m| PairMaterial::gather([m; LANES]));
     let PairSlices { pairs, consts, hist, energy, active } = list;
     for (ks, ds) in touching[..quads].chunks_exact(LANES).zip(sep.chunks_exact(LANES)) {
-        let slices = PairSlices::<T, Rr> { pairs, consts, hist: &mut *hist, energy: &mut *energy, active: &mut *active };
-        four_pairs::<N, Dm, T, C, Rr, ENERGY, SPIN>(w, slices, single.as_ref(), ks, ds, &mut sink, &mut best);
+        let slices = PairSlices::<T, Rr, D> { pairs, consts, hist: &mut *hist, energy: &mut *energy, active: &mut *active };
+        four_pairs::<N, Dm, T, C, Rr, D, ENERGY, SPIN>(w, slices, single.as_ref(), ks, ds, &mut sink, &mut best);
     }
     for (m, &k) in touching.iter().enumerate().skip(quads) {
         let k = k as usize;
         let [i, j] = pairs.pairs()[k].map(|g| g as usize);
-        let (o, n, state) = one_pair::<N, Dm, T, C, Rr, SPIN>(w, (i, j), sep[m], &consts[k], &mut hist[k], &mut active[k]);
+        let (o, n, state) = one_pair::<N, Dm, T, C, Rr, D, SPIN>(w, (i, j), sep[m], &consts[k], &mut hist[k], &mut active[k]);
         if o.ratio > best.0 {
             best = (o.ratio, k);
         }
@@ -273,19 +273,19 @@ pub fn compute_pairs<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rol
             w.law.energy_step(n, w.dt, &state, &mut energy[k]);
         }
     }
-    let mut none = EnergyMemory::<f64, Rr::Energy>::default();
+    let mut none = EnergyMemory::<f64, Rr::Energy, D>::default();
     for &k in released {
         let k = k as usize;
         let e = if ENERGY { &mut energy[k] } else { &mut none };
-        pair_contact::<N, Dm, T, C, Rr, ENERGY>(w, pairs.pairs()[k], &consts[k], &mut hist[k], e, &mut active[k]);
+        pair_contact::<N, Dm, T, C, Rr, D, ENERGY>(w, pairs.pairs()[k], &consts[k], &mut hist[k], e, &mut active[k]);
     }
     best
 }
 
 /// What the pair kernel reads: everything but the forces it produces.
-pub struct PairView<'a, L: ContactLaw> {
-    pub p: &'a Particles,
-    pub boundary: Boundary,
+pub struct PairView<'a, L, D: Dim = Plane> {
+    pub p: &'a Particles<D>,
+    pub boundary: Boundary<D>,
     pub law: L,
     pub pair_table: &'a crate::physics::material::PairTable,
     pub dt: f64,

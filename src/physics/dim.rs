@@ -12,7 +12,7 @@
 
 use std::f64::consts::PI;
 use std::fmt::Debug;
-use std::ops::{Add, AddAssign, Index, IndexMut, Mul, Neg, Sub, SubAssign};
+use std::ops::{Add, AddAssign, Div, Index, IndexMut, Mul, Neg, Sub, SubAssign};
 
 use nalgebra::{Vector2, Vector3};
 use schemars::JsonSchema;
@@ -41,12 +41,13 @@ pub trait Dim: Copy + Default + Debug + Send + Sync + 'static {
         + Sub<Output = Self::Vector<R>>
         + Neg<Output = Self::Vector<R>>
         + Mul<R, Output = Self::Vector<R>>
+        + Div<R, Output = Self::Vector<R>>
         + AddAssign
         + SubAssign
         + Index<usize, Output = R>
         + IndexMut<usize>;
     /// A spin or a torque: a number about z in the plane, a vector in space (rad/s, N m).
-    type Spin<R: Real>: Copy + Default + Debug + Send + Sync + Add<Output = Self::Spin<R>> + Mul<R, Output = Self::Spin<R>>;
+    type Spin<R: Real>: Copy + Default + Debug + Send + Sync + Add<Output = Self::Spin<R>> + Sub<Output = Self::Spin<R>> + Mul<R, Output = Self::Spin<R>>;
     /// What turns a contact about its normal: the pair's spin sum `w_i + w_j` in space
     /// (rad/s); `()` in the plane, where every spin is perpendicular to the normal.
     type Twist<R: Real>: Copy + Default + Debug + Send + Sync;
@@ -62,6 +63,13 @@ pub trait Dim: Copy + Default + Debug + Send + Sync + 'static {
     fn gather(f: impl Fn(usize) -> Self::Vector<f64>) -> Self::Vector<Lanes>;
     /// One lane of a vector of lanes.
     fn lane(v: &Self::Vector<Lanes>, l: usize) -> Self::Vector<f64>;
+    /// Spin lanes filled from `f(lane)`.
+    fn gather_spin(f: impl Fn(usize) -> Self::Spin<f64>) -> Self::Spin<Lanes>;
+    /// One lane of a spin of lanes.
+    fn spin_lane(w: &Self::Spin<Lanes>, l: usize) -> Self::Spin<f64>;
+    /// What turns a contact about its normal ([`Dim::Twist`]) from the pair's spin sum
+    /// `w_i + w_j`: itself in space, nothing in the plane.
+    fn twist<R: Real>(spin_sum: Self::Spin<R>) -> Self::Twist<R>;
     fn save(v: Self::Vector<f64>) -> Self::Saved;
     fn load(s: Self::Saved) -> Self::Vector<f64>;
     /// `w x a`: the velocity of a point at `a` from the centre of a grain spinning at `w`.
@@ -168,6 +176,17 @@ impl Dim for Plane {
         crate::physics::lanes::lane2(v, l)
     }
     #[inline(always)]
+    fn gather_spin(f: impl Fn(usize) -> f64) -> Lanes {
+        gather(f)
+    }
+    #[inline(always)]
+    fn spin_lane(w: &Lanes, l: usize) -> f64 {
+        use simba::simd::SimdValue;
+        w.extract(l)
+    }
+    #[inline(always)]
+    fn twist<R: Real>(_: R) {}
+    #[inline(always)]
     fn spin_cross<R: Real>(w: R, a: Vector2<R>) -> Vector2<R> {
         Vector2::new(-w * a.y, w * a.x)
     }
@@ -231,6 +250,18 @@ impl Dim for Space {
     fn lane(v: &Vector3<Lanes>, l: usize) -> Vector3<f64> {
         use simba::simd::SimdValue;
         Vector3::new(v.x.extract(l), v.y.extract(l), v.z.extract(l))
+    }
+    #[inline(always)]
+    fn gather_spin(f: impl Fn(usize) -> Vector3<f64>) -> Vector3<Lanes> {
+        Self::gather(f)
+    }
+    #[inline(always)]
+    fn spin_lane(w: &Vector3<Lanes>, l: usize) -> Vector3<f64> {
+        Self::lane(w, l)
+    }
+    #[inline(always)]
+    fn twist<R: Real>(spin_sum: Vector3<R>) -> Vector3<R> {
+        spin_sum
     }
     #[inline(always)]
     fn spin_cross<R: Real>(w: Vector3<R>, a: Vector3<R>) -> Vector3<R> {

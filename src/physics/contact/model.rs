@@ -7,7 +7,6 @@ use std::marker::PhantomData;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
-use nalgebra::Vector2;
 
 use super::cohesion::{Cohesion, Dmt, NoCohesion};
 use super::rolling::{Cdt, Epsd2, InLanes, NoRolling, Rolling, RollingEnergy, RollingInput, Sds};
@@ -233,23 +232,26 @@ impl<X: Copy + RollingEnergy<f64, D::Spin<f64>>, D: Dim> EnergyMemory<f64, X, D>
     }
 }
 
-impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling> ContactModel<N, Dm, T, C, Rr> {
+/// A contact's energy memory in lanes under a rolling law `Rr` in dimension `D`.
+pub type MemoryLanes<Rr, D> = EnergyMemory<crate::physics::lanes::Lanes, <<Rr as Rolling<D>>::Energy as InLanes>::Lanes, D>;
+
+impl<N: Normal, Dm: Damping, T: Tangential<D>, C: Cohesion, Rr: Rolling<D>, D: Dim> ContactModel<N, Dm, T, C, Rr, D> {
     /// Four contacts' energy memories in lanes; with `friction` false only what a
     /// frictionless contact uses (the normal damping's previous force and sum), the rest 0.
     #[inline(always)]
-    pub fn gather_energy(h: [&EnergyMemory<f64, Rr::Energy>; crate::physics::lanes::LANES], friction: bool) -> EnergyMemory<crate::physics::lanes::Lanes, <Rr::Energy as InLanes>::Lanes> {
-        use crate::physics::lanes::{Lanes, gather, gather2};
+    pub fn gather_energy(h: [&EnergyMemory<f64, Rr::Energy, D>; crate::physics::lanes::LANES], friction: bool) -> MemoryLanes<Rr, D> {
+        use crate::physics::lanes::{Lanes, gather};
         use simba::simd::SimdValue;
         let rolling = InLanes::gather(h.map(|x| &x.rolling));
         if !friction {
             let z = Lanes::splat(0.0);
             let sums = EnergySums { normal_damping: gather(|l| h[l].sums.normal_damping), tangential_damping: z, friction: z, tangential_model: z };
-            return EnergyMemory { fd_prev: gather(|l| h[l].fd_prev), fte_prev: Vector2::new(z, z), ftd_prev: Vector2::new(z, z), sums, rolling };
+            return EnergyMemory { fd_prev: gather(|l| h[l].fd_prev), fte_prev: D::zero(), ftd_prev: D::zero(), sums, rolling };
         }
         EnergyMemory {
             fd_prev: gather(|l| h[l].fd_prev),
-            fte_prev: gather2(|l| h[l].fte_prev),
-            ftd_prev: gather2(|l| h[l].ftd_prev),
+            fte_prev: D::gather(|l| h[l].fte_prev),
+            ftd_prev: D::gather(|l| h[l].ftd_prev),
             sums: EnergySums {
                 normal_damping: gather(|l| h[l].sums.normal_damping),
                 tangential_damping: gather(|l| h[l].sums.tangential_damping),
@@ -262,7 +264,7 @@ impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling> ContactMod
     /// Write lane `l` of the memories `e` to `m` (with `friction` false, only what a
     /// frictionless contact uses).
     #[inline(always)]
-    pub fn store_energy_lane(e: &EnergyMemory<crate::physics::lanes::Lanes, <Rr::Energy as InLanes>::Lanes>, l: usize, m: &mut EnergyMemory<f64, Rr::Energy>, friction: bool) {
+    pub fn store_energy_lane(e: &MemoryLanes<Rr, D>, l: usize, m: &mut EnergyMemory<f64, Rr::Energy, D>, friction: bool) {
         use simba::simd::SimdValue;
         if friction {
             *m = Self::energy_lane(e, l);
@@ -274,14 +276,13 @@ impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling> ContactMod
     }
     /// The memory in lane `l`.
     #[inline(always)]
-    pub fn energy_lane(e: &EnergyMemory<crate::physics::lanes::Lanes, <Rr::Energy as InLanes>::Lanes>, l: usize) -> EnergyMemory<f64, Rr::Energy> {
-        use crate::physics::lanes::lane2;
+    pub fn energy_lane(e: &MemoryLanes<Rr, D>, l: usize) -> EnergyMemory<f64, Rr::Energy, D> {
         use simba::simd::SimdValue;
         let s = &e.sums;
         EnergyMemory {
             fd_prev: e.fd_prev.extract(l),
-            fte_prev: lane2(&e.fte_prev, l),
-            ftd_prev: lane2(&e.ftd_prev, l),
+            fte_prev: D::lane(&e.fte_prev, l),
+            ftd_prev: D::lane(&e.ftd_prev, l),
             sums: EnergySums { normal_damping: s.normal_damping.extract(l), tangential_damping: s.tangential_damping.extract(l), friction: s.friction.extract(l), tangential_model: s.tangential_model.extract(l) },
             rolling: InLanes::lane(&e.rolling, l),
         }
