@@ -2,6 +2,8 @@
 //! touching pair's input gathered from the grains' arrays, the law run one pair or four
 //! in SIMD lanes, the forces and torques handed out (`compute_pairs`).
 //!
+//! - the contact sweep sorts out the touching pairs and their separations as a direct
+//!   test of each pair does, bit for bit, in the plane and space;
 //! - in space, four pairs in lanes give each pair the bits it gets alone, over several
 //!   steps of history, with the energy memories (every tangential law but micro-slip);
 //! - the plane's packing placed at z = 0 gives the plane's forces, torques, histories
@@ -13,6 +15,7 @@
 use grainlab::kernels::cells::cell_pairs;
 use grainlab::kernels::driver::{PairOut, PairSlices, PairView, compute_pairs};
 use grainlab::kernels::pairs::PairList;
+use grainlab::kernels::sweep::sort_pairs_portable;
 use grainlab::kernels::threads::Threads;
 use grainlab::physics::boundary::Boundary;
 use grainlab::physics::contact::cohesion::NoCohesion;
@@ -77,6 +80,11 @@ fn drive<T: Tangential<D>, D: Dim>(p: &Particles<D>, b: Boundary<D>, steps: usiz
     let touching: Vec<u32> = (0..np as u32).filter(|&k| D::norm(sep[k as usize]) < p.r[list.pairs[k as usize][0] as usize] + p.r[list.pairs[k as usize][1] as usize]).collect();
     let seps: Vec<D::Vector<f64>> = touching.iter().map(|&k| sep[k as usize]).collect();
     assert!(touching.len() > 40, "{} touching pairs: too few to mean anything", touching.len());
+    // The contact sweep (four pairs' distances in lanes, then one by one) sorts out the
+    // same pairs with the same separations, bit for bit.
+    let (mut t, mut s, mut rel) = (Vec::new(), Vec::new(), Vec::new());
+    let (nt, nr) = sort_pairs_portable(&p.x, &b, list.pairs.checked(), &list.reach, &list.active, &[], &mut t, &mut s, &mut rel);
+    assert!(t[..nt] == touching[..] && nr == 0 && s[..nt].iter().zip(&seps).all(|(a, c)| bits::<D>(*a) == bits::<D>(*c)), "the sweep's {nt} touching pairs against {}", touching.len());
     let mut outs = Vec::new();
     for _ in 0..steps {
         let mut out = vec![PairOut::<D>::default(); np];

@@ -4,13 +4,12 @@
 //! `kernels::avx512` and `kernels::avx2` (one of them in a build, by its target CPU; with
 //! what they share, [`crate::kernels::wide`]) give the portable sweep's bits. Uses physics and the pair list.
 
-use nalgebra::Vector2;
 use simba::simd::{SimdBool, SimdPartialOrd};
 use crate::kernels::pairs::CheckedPairs;
 use crate::kernels::wide::{WideLoop, four_flags};
 use crate::physics::boundary::Boundary;
-use crate::physics::dim::Vec2;
-use crate::physics::lanes::{LANES, Lanes, gather, gather2, lane2};
+use crate::physics::dim::{Dim, Vec2};
+use crate::physics::lanes::{LANES, Lanes, gather};
 
 /// The pairs of a list part that are touching, and those that were at the previous step
 /// and are not any more, as indices into the part, in list order: the first `nt` of
@@ -83,12 +82,7 @@ fn sweep_wide(
 #[allow(clippy::too_many_arguments)]
 fn sort_pairs_with(wide: bool, x: &[Vec2], boundary: &Boundary, pairs: CheckedPairs<'_>, reach: &[f64], active: &[bool], skip: &[u32], touching: &mut Vec<u32>, sep: &mut Vec<Vec2>, released: &mut Vec<u32>) -> (usize, usize) {
     let np = pairs.len();
-    if touching.len() < np {
-        touching.resize(np, 0);
-        sep.resize(np, Vec2::zeros());
-        released.resize(np, 0);
-    }
-    let (reach, active, touching, sep, released) = (&reach[..np], &active[..np], &mut touching[..np], &mut sep[..np], &mut released[..np]);
+    let (reach, active, touching, sep, released) = lists(np, reach, active, touching, sep, released);
     let (mut nt, mut nr, mut from) = (0, 0, 0);
     // Where the build has a CPU-specific sweep, it takes all but a short tail.
     let skip = match WIDE_SWEEP {
@@ -98,23 +92,53 @@ fn sort_pairs_with(wide: bool, x: &[Vec2], boundary: &Boundary, pairs: CheckedPa
         }
         _ => skip,
     };
-    for to in skip.iter().map(|&k| k as usize).chain(std::iter::once(np)) {
+    sweep_stretches(x, boundary, pairs, (reach, active), skip, from, (touching, sep, released), (&mut nt, &mut nr));
+    (nt, nr)
+}
+
+/// [`sort_pairs`] in the plane or in space, with the portable sweep alone (the
+/// CPU-specific sweeps are the plane's).
+#[allow(clippy::too_many_arguments)]
+pub fn sort_pairs_portable<D: Dim>(x: &[D::Vector<f64>], boundary: &Boundary<D>, pairs: CheckedPairs<'_>, reach: &[f64], active: &[bool], skip: &[u32], touching: &mut Vec<u32>, sep: &mut Vec<D::Vector<f64>>, released: &mut Vec<u32>) -> (usize, usize) {
+    let (reach, active, touching, sep, released) = lists(pairs.len(), reach, active, touching, sep, released);
+    let (mut nt, mut nr) = (0, 0);
+    sweep_stretches(x, boundary, pairs, (reach, active), skip, 0, (touching, sep, released), (&mut nt, &mut nr));
+    (nt, nr)
+}
+
+/// The per-pair slices of a sort cut to the `np` pairs, the output lists grown to them
+/// first (they keep their length from step to step).
+#[allow(clippy::type_complexity)]
+fn lists<'a, V: Copy + Default>(np: usize, reach: &'a [f64], active: &'a [bool], touching: &'a mut Vec<u32>, sep: &'a mut Vec<V>, released: &'a mut Vec<u32>) -> (&'a [f64], &'a [bool], &'a mut [u32], &'a mut [V], &'a mut [u32]) {
+    if touching.len() < np {
+        touching.resize(np, 0);
+        sep.resize(np, V::default());
+        released.resize(np, 0);
+    }
+    (&reach[..np], &active[..np], &mut touching[..np], &mut sep[..np], &mut released[..np])
+}
+
+/// The portable sweep from pair `from` on, over the stretches between the pairs of
+/// `skip` (ascending, all at or after `from`).
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn sweep_stretches<D: Dim>(x: &[D::Vector<f64>], boundary: &Boundary<D>, pairs: CheckedPairs<'_>, (reach, active): (&[f64], &[bool]), skip: &[u32], mut from: usize, (touching, sep, released): (&mut [u32], &mut [D::Vector<f64>], &mut [u32]), (nt, nr): (&mut usize, &mut usize)) {
+    for to in skip.iter().map(|&k| k as usize).chain(std::iter::once(pairs.len())) {
         if to > from {
-            sweep(x, boundary, pairs, reach, active, from..to, touching, sep, released, &mut nt, &mut nr);
+            sweep(x, boundary, pairs, reach, active, from..to, touching, sep, released, nt, nr);
         }
         from = to + 1;
     }
-    (nt, nr)
 }
 
 /// The sweep of [`sort_pairs`] over the pairs `range` of the part: four pairs'
 /// distances at a time in lanes, then their indices appended where they belong (from
 /// `nt` and `nr` on, which it moves on). Every pair before the range is already sorted
 /// out or skipped, so `nt` and `nr` are at most its first index and every write is in
-/// bounds.
+/// bounds. Written once for the plane and space.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-fn sweep(x: &[Vec2], boundary: &Boundary, pairs: CheckedPairs<'_>, reach: &[f64], active: &[bool], range: std::ops::Range<usize>, touching: &mut [u32], sep: &mut [Vec2], released: &mut [u32], nt: &mut usize, nr: &mut usize) {
+fn sweep<D: Dim>(x: &[D::Vector<f64>], boundary: &Boundary<D>, pairs: CheckedPairs<'_>, reach: &[f64], active: &[bool], range: std::ops::Range<usize>, touching: &mut [u32], sep: &mut [D::Vector<f64>], released: &mut [u32], nt: &mut usize, nr: &mut usize) {
     let xs = pairs.of(x);
     let (mut t, mut r) = (*nt, *nr);
     // Every index written below is at most the index of the pair being sorted out
@@ -126,8 +150,8 @@ fn sweep(x: &[Vec2], boundary: &Boundary, pairs: CheckedPairs<'_>, reach: &[f64]
     for (q, (rq, aq)) in reach[..quads].chunks_exact(LANES).zip(active[..quads].chunks_exact(LANES)).enumerate() {
         let k = k0 + q * LANES;
         let g = xs.four(k);
-        let d: Vector2<Lanes> = boundary.image(gather2(|l| g[l].0 - g[l].1));
-        let touch = d.norm_squared().simd_lt(gather(|l| rq[l])).bitmask();
+        let d: D::Vector<Lanes> = boundary.image(D::gather(|l| g[l].0 - g[l].1));
+        let touch = D::norm_squared(d).simd_lt(gather(|l| rq[l])).bitmask();
         let was = four_flags([aq[0] as u8, aq[1] as u8, aq[2] as u8, aq[3] as u8]) as u64;
         // Touching: every index written, the count moved on where it touches.
         for l in 0..LANES {
@@ -135,7 +159,7 @@ fn sweep(x: &[Vec2], boundary: &Boundary, pairs: CheckedPairs<'_>, reach: &[f64]
             // SAFETY: t <= k + l < range.end <= touching.len(), sep.len() (asserted above).
             unsafe {
                 *touching.get_unchecked_mut(t) = (k + l) as u32;
-                *sep.get_unchecked_mut(t) = lane2(&d, l);
+                *sep.get_unchecked_mut(t) = D::lane(&d, l);
             }
             t += touch as usize >> l & 1;
         }
@@ -152,7 +176,7 @@ fn sweep(x: &[Vec2], boundary: &Boundary, pairs: CheckedPairs<'_>, reach: &[f64]
         let k = k0 + m;
         let (xi, xj) = xs.at(k);
         let d = boundary.image(xi - xj);
-        let touch = d.norm_squared() < reach[m];
+        let touch = D::norm_squared(d) < reach[m];
         touching[t] = k as u32;
         sep[t] = d;
         released[r] = k as u32;
