@@ -19,7 +19,7 @@ use crate::physics::contact::normal::{Hertz, Normal};
 use crate::physics::contact::model::*;
 use crate::physics::contact::tangential::Tangential;
 use crate::physics::contact::{ContactHistory, ContactModel, ModelOptions};
-use crate::physics::dim::Vec2;
+use crate::physics::dim::{Dim, Plane, Space, Vec2};
 use crate::physics::energy::EnergyLedger;
 use crate::physics::material::{PairMaterial, PairTable};
 use crate::physics::particles::Particles;
@@ -476,7 +476,6 @@ impl Parts<'_> {
     }
 
     fn assemble_with<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling, const E: bool>(self, law: ContactModel<N, Dm, T, C, Rr>) -> Result<Box<dyn Engine>, Error> {
-        type L<N, Dm, T, C, Rr> = ContactModel<N, Dm, T, C, Rr>;
         let scene = self.scene;
         let rotation = T::FRICTION && scene.model.rotation;
         let has_walls = !self.walls.is_empty();
@@ -511,51 +510,115 @@ impl Parts<'_> {
             domain: self.domain,
             context: self.context,
         };
-        // The force stages, shared by the step and by the set-up at t = 0.
-        let threads = self.threads.clone();
-        type Stages<N, Dm, T, C, Rr> = Vec<Box<dyn Stage<L<N, Dm, T, C, Rr>>>>;
-        let forces = || -> Result<Stages<N, Dm, T, C, Rr>, Error> {
-            let mut s: Stages<N, Dm, T, C, Rr> = vec![Box::new(UpdateNeighbours), Box::new(ClearForces)];
-            if pulled {
-                s.push(Box::new(Gravity::<E>));
-            }
-            if let Some(c) = scene.model.general_damping {
-                s.push(Box::new(GeneralDamping::<E>::new(c)));
-            }
-            if scene.output.contacts {
-                s.push(if rotation { Box::new(RecordContacts::<true>) } else { Box::new(RecordContacts::<false>) });
-            }
-            s.push(if rotation { pair_stage::<N, Dm, T, C, Rr, E, true>(&threads) } else { pair_stage::<N, Dm, T, C, Rr, E, false>(&threads) });
-            if has_flat {
-                s.push(Box::new(FlatWallForces::<E>));
-            }
-            Ok(s)
+        let plan = Plan {
+            rotation,
+            walls: has_walls,
+            flat_walls: has_flat,
+            gravity: pulled,
+            general_damping: scene.model.general_damping,
+            contacts: scene.output.contacts,
+            threads: self.threads.clone(),
         };
-        let mut stages: Stages<N, Dm, T, C, Rr> = Vec::new();
-        // The walls first: their grains follow them in the drift.
-        if has_walls {
-            stages.push(Box::new(MoveWalls));
-        }
-        if rotation {
-            stages.push(Box::new(InitialIntegrate::<true>::default()));
-        } else {
-            stages.push(Box::new(InitialIntegrate::<false>::default()));
-        }
-        stages.extend(forces()?);
-        if has_walls {
-            stages.push(Box::new(FinishWalls::<E>));
-        }
-        if rotation {
-            stages.push(Box::new(FinalIntegrate::<true>));
-        } else {
-            stages.push(Box::new(FinalIntegrate::<false>));
-        }
-        stages.push(Box::new(Watchdog { max_overlap: MAX_START_OVERLAP, every: 100 }));
-        let mut setup = forces()?;
-        if has_walls {
-            setup.push(Box::new(FinishWalls::<E>));
-        }
+        let (stages, setup) = pipeline::<N, Dm, T, C, Rr, Plane, E>(&plan);
         Ok(Box::new(Simulation::new(world, stages, setup)?))
+    }
+}
+
+/// What a scene asks of the step's pipeline (the same in the plane and in space).
+#[derive(Clone)]
+pub struct Plan {
+    /// The grains rotate (friction, and the scene's `model.rotation`).
+    pub rotation: bool,
+    /// The scene has walls.
+    pub walls: bool,
+    /// ... and one of them is flat.
+    pub flat_walls: bool,
+    /// Gravity is on at some time of the run.
+    pub gravity: bool,
+    /// The seed's general damping rate, 1/s.
+    pub general_damping: Option<f64>,
+    /// Record the contacts (`output.contacts`).
+    pub contacts: bool,
+    /// The threads the stages may use.
+    pub threads: crate::kernels::threads::Threads,
+}
+
+/// The stages of a step and of the set-up at t = 0 (the force stages, then the walls'
+/// forces) for contact model `ContactModel<N, Dm, T, C, Rr, D>` and the energy ledger
+/// (`E`), in the order a step runs them: written once for the plane and space; what
+/// differs between them is [`Pipeline`]'s.
+#[allow(clippy::type_complexity)]
+pub fn pipeline<N: Normal, Dm: Damping, T: Tangential<D>, C: Cohesion, Rr: Rolling<D>, D: Pipeline, const E: bool>(plan: &Plan) -> (Vec<Box<dyn Stage<ContactModel<N, Dm, T, C, Rr, D>>>>, Vec<Box<dyn Stage<ContactModel<N, Dm, T, C, Rr, D>>>>) {
+    type Stages<N, Dm, T, C, Rr, D> = Vec<Box<dyn Stage<ContactModel<N, Dm, T, C, Rr, D>>>>;
+    let rotation = plan.rotation;
+    // The force stages, shared by the step and by the set-up at t = 0.
+    let forces = || -> Stages<N, Dm, T, C, Rr, D> {
+        let mut s: Stages<N, Dm, T, C, Rr, D> = vec![Box::new(UpdateNeighbours), Box::new(ClearForces)];
+        if plan.gravity {
+            s.push(Box::new(Gravity::<E>));
+        }
+        if let Some(c) = plan.general_damping {
+            s.push(Box::new(GeneralDamping::<E, D>::new(c)));
+        }
+        if plan.contacts {
+            s.extend(if rotation { D::record_stage::<N, Dm, T, C, Rr, true>() } else { D::record_stage::<N, Dm, T, C, Rr, false>() });
+        }
+        s.push(if rotation { D::pair_stage::<N, Dm, T, C, Rr, E, true>(&plan.threads) } else { D::pair_stage::<N, Dm, T, C, Rr, E, false>(&plan.threads) });
+        if plan.flat_walls {
+            s.push(Box::new(FlatWallForces::<E>));
+        }
+        s
+    };
+    let mut stages: Stages<N, Dm, T, C, Rr, D> = Vec::new();
+    // The walls first: their grains follow them in the drift.
+    if plan.walls {
+        stages.push(Box::new(MoveWalls));
+    }
+    if rotation {
+        stages.push(Box::new(InitialIntegrate::<true, D>::default()));
+    } else {
+        stages.push(Box::new(InitialIntegrate::<false, D>::default()));
+    }
+    stages.extend(forces());
+    if plan.walls {
+        stages.push(Box::new(FinishWalls::<E>));
+    }
+    if rotation {
+        stages.push(Box::new(FinalIntegrate::<true>));
+    } else {
+        stages.push(Box::new(FinalIntegrate::<false>));
+    }
+    stages.push(Box::new(Watchdog { max_overlap: MAX_START_OVERLAP, every: 100 }));
+    let mut setup = forces();
+    if plan.walls {
+        setup.push(Box::new(FinishWalls::<E>));
+    }
+    (stages, setup)
+}
+
+/// What the pipeline's stages differ by in the plane and in space: the grain-grain
+/// contact stage (in the plane serial or on the run's threads, in space serial so far)
+/// and the contact record (the plane's only so far: space refuses `output.contacts`).
+pub trait Pipeline: Dim {
+    fn pair_stage<N: Normal, Dm: Damping, T: Tangential<Self>, C: Cohesion, Rr: Rolling<Self>, const E: bool, const SPIN: bool>(threads: &crate::kernels::threads::Threads) -> Box<dyn Stage<ContactModel<N, Dm, T, C, Rr, Self>>>;
+    fn record_stage<N: Normal, Dm: Damping, T: Tangential<Self>, C: Cohesion, Rr: Rolling<Self>, const SPIN: bool>() -> Option<Box<dyn Stage<ContactModel<N, Dm, T, C, Rr, Self>>>>;
+}
+
+impl Pipeline for Plane {
+    fn pair_stage<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling, const E: bool, const SPIN: bool>(threads: &crate::kernels::threads::Threads) -> Box<dyn Stage<ContactModel<N, Dm, T, C, Rr>>> {
+        pair_stage::<N, Dm, T, C, Rr, E, SPIN>(threads)
+    }
+    fn record_stage<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling, const SPIN: bool>() -> Option<Box<dyn Stage<ContactModel<N, Dm, T, C, Rr>>>> {
+        Some(Box::new(RecordContacts::<SPIN>))
+    }
+}
+
+impl Pipeline for Space {
+    fn pair_stage<N: Normal, Dm: Damping, T: Tangential<Space>, C: Cohesion, Rr: Rolling<Space>, const E: bool, const SPIN: bool>(_: &crate::kernels::threads::Threads) -> Box<dyn Stage<ContactModel<N, Dm, T, C, Rr, Space>>> {
+        Box::new(PairForces::<E, SPIN, Space>::default())
+    }
+    fn record_stage<N: Normal, Dm: Damping, T: Tangential<Space>, C: Cohesion, Rr: Rolling<Space>, const SPIN: bool>() -> Option<Box<dyn Stage<ContactModel<N, Dm, T, C, Rr, Space>>>> {
+        None
     }
 }
 

@@ -15,7 +15,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use crate::engine::world::{PendingKick, Stage, World};
 use crate::error::Error;
 use crate::physics::contact::ContactLaw;
-use crate::physics::dim::{Dim, Plane, Vec2};
+use crate::physics::dim::{Dim, Plane};
 use crate::physics::walls::Glued;
 
 /// Give the final half kick left pending ([`crate::engine::world::KickFactors::pending`]), if any: the
@@ -42,14 +42,14 @@ pub fn settle<L: ContactLaw>(w: &mut World<L>) {
 /// (In the contact stage the first thread adds their forces; moving their zeroing to it,
 /// in `ClearForces`, timed the same at 100 000 grains.)
 #[derive(Default)]
-pub struct InitialIntegrate<const ROT: bool> {
+pub struct InitialIntegrate<const ROT: bool, D: Dim = Plane> {
     /// Stands in for the positions at the last build before there is a build.
-    origin: Vec<Vec2>,
+    origin: Vec<D::Vector<f64>>,
     /// The rough walls' grains and their moves this step.
-    glued: Vec<Glued>,
+    glued: Vec<Glued<D>>,
 }
 
-impl<L: ContactLaw, const ROT: bool> Stage<L> for InitialIntegrate<ROT> {
+impl<L: ContactLaw<D = D>, D: Dim, const ROT: bool> Stage<L> for InitialIntegrate<ROT, D> {
     fn name(&self) -> String {
         if ROT { "VelocityVerlet(x, v, w)".into() } else { "VelocityVerlet(x, v)".into() }
     }
@@ -69,7 +69,7 @@ impl<L: ContactLaw, const ROT: bool> Stage<L> for InitialIntegrate<ROT> {
         let listed = w.neighbours.at_build().len() == n;
         if !listed {
             // No list yet: the next stage builds one whatever this pass finds.
-            self.origin.resize(n, Vec2::zeros());
+            self.origin.resize(n, D::zero());
         }
         let at = if listed { w.neighbours.at_build() } else { &self.origin[..] };
         self.glued.clear();
@@ -87,24 +87,30 @@ impl<L: ContactLaw, const ROT: bool> Stage<L> for InitialIntegrate<ROT> {
             let (torque, tg) = torque.split_at_mut(nf);
             let (at, atg) = at.split_at(nf);
             // Where the build has AVX-512, eight grains at a time first (the same bits),
-            // with the pending kick in the same pass.
+            // with the pending kick in the same pass: in the plane.
             #[cfg(all(target_arch = "x86_64", target_feature = "avx512f", target_feature = "avx512vl", target_feature = "avx512bw"))]
-            let (from, mut far_here, out) = {
-                let g = crate::kernels::avx512::GrainPart { v: &mut *v, f: &mut *f, dtfm, omega: &mut *omega, torque: &mut *torque, dtfi };
-                if twice {
-                    crate::kernels::avx512::drift::<ROT, true>(g, &mut *x, at, dt, &b, limit)
-                } else {
-                    crate::kernels::avx512::drift::<ROT, false>(g, &mut *x, at, dt, &b, limit)
+            let (from, mut far_here, out) = match (D::plane_vectors_mut(v), D::plane_vectors_mut(f), D::plane_spins_mut(omega), D::plane_spins_mut(torque), D::plane_spins(dtfi), D::plane_vectors_mut(x), D::plane_vectors(at), b.plane()) {
+                (Some(v), Some(f), Some(omega), Some(torque), Some(dtfi), Some(x), Some(at), Some(b)) => {
+                    let g = crate::kernels::avx512::GrainPart { v, f, dtfm, omega, torque, dtfi };
+                    if twice {
+                        crate::kernels::avx512::drift::<ROT, true>(g, x, at, dt, &b, limit)
+                    } else {
+                        crate::kernels::avx512::drift::<ROT, false>(g, x, at, dt, &b, limit)
+                    }
                 }
+                _ => (0, false, false),
             };
             #[cfg(not(all(target_arch = "x86_64", target_feature = "avx512f", target_feature = "avx512vl", target_feature = "avx512bw")))]
-            let (from, mut far_here, out) = (0, false, false);
+            let (from, mut far_here, out) = {
+                let _ = dtfm;
+                (0, false, false)
+            };
             let part = (&mut v[from..], &mut x[from..], &mut f[from..], &dtfm2[from..]);
             let spin = (&mut omega[from..], &mut torque[from..], &dtfi[from..]);
             if twice {
-                drift_free::<Plane, ROT, true>(part, spin, dt);
+                drift_free::<D, ROT, true>(part, spin, dt);
             } else {
-                drift_free::<Plane, ROT, false>(part, spin, dt);
+                drift_free::<D, ROT, false>(part, spin, dt);
             }
             // Back into the periodic cell: rarely anyone to bring back, so one check of
             // all first (the wrap itself is a chain of roundings per grain).
@@ -123,9 +129,9 @@ impl<L: ContactLaw, const ROT: bool> Stage<L> for InitialIntegrate<ROT> {
                     far_here |= g.follow(&mut xg[part.clone()], &mut vg[part.clone()], &atg[part], &b, limit);
                 }
             }
-            fg.fill(Vec2::zeros());
+            fg.fill(D::zero());
             if ROT {
-                tg.fill(0.0);
+                tg.fill(D::spin_zero());
             }
             if far_here {
                 far.store(true, Ordering::Relaxed);
@@ -184,16 +190,19 @@ pub fn kick_components<D: Dim, const ROT: bool>(v: &mut [D::Vector<f64>], f: &[D
 }
 
 /// A half kick of free grains `v` (and with `ROT` their spins `omega`) from their forces
-/// and torques.
-fn kick_part<const ROT: bool>(v: &mut [Vec2], f: &mut [Vec2], (dtfm, dtfm2): (&[f64], &[Vec2]), omega: &mut [f64], torque: &mut [f64], dtfi: &[f64]) {
+/// and torques; in the plane with AVX-512 eight grains at a time first.
+fn kick_part<D: Dim, const ROT: bool>(v: &mut [D::Vector<f64>], f: &mut [D::Vector<f64>], (dtfm, dtfm2): (&[f64], &[D::Vector<f64>]), omega: &mut [D::Spin<f64>], torque: &mut [D::Spin<f64>], dtfi: &[D::Spin<f64>]) {
     #[cfg(all(target_arch = "x86_64", target_feature = "avx512f", target_feature = "avx512vl", target_feature = "avx512bw"))]
-    let from = crate::kernels::avx512::kick::<ROT>(crate::kernels::avx512::GrainPart { v: &mut *v, f: &mut *f, dtfm, omega: &mut *omega, torque: &mut *torque, dtfi });
+    let from = match (D::plane_vectors_mut(v), D::plane_vectors_mut(f), D::plane_spins_mut(omega), D::plane_spins_mut(torque), D::plane_spins(dtfi)) {
+        (Some(v), Some(f), Some(omega), Some(torque), Some(dtfi)) => crate::kernels::avx512::kick::<ROT>(crate::kernels::avx512::GrainPart { v, f, dtfm, omega, torque, dtfi }),
+        _ => 0,
+    };
     #[cfg(not(all(target_arch = "x86_64", target_feature = "avx512f", target_feature = "avx512vl", target_feature = "avx512bw")))]
     let from = {
         let _ = dtfm;
         0
     };
-    kick_components::<Plane, ROT>(&mut v[from..], &f[from..], &dtfm2[from..], (&mut omega[from..], &torque[from..], &dtfi[from..]));
+    kick_components::<D, ROT>(&mut v[from..], &f[from..], &dtfm2[from..], (&mut omega[from..], &torque[from..], &dtfi[from..]));
 }
 
 /// The half kick of all free grains for time step `dt`, on the run's threads.
@@ -203,7 +212,7 @@ fn kick_free<L: ContactLaw, const ROT: bool>(w: &mut World<L>, dt: f64) {
     let k = &mut w.kick;
     k.update(p, dt);
     let rotation = (&mut p.omega[..n], &mut p.torque[..n], &k.dtfi[..]);
-    w.threads.split(n, ((&mut p.v[..n], &mut p.f[..n], (&k.dtfm[..], &k.dtfm2[..])), rotation), |((v, f, dtfm), (omega, torque, dtfi))| kick_part::<ROT>(v, f, dtfm, omega, torque, dtfi));
+    w.threads.split(n, ((&mut p.v[..n], &mut p.f[..n], (&k.dtfm[..], &k.dtfm2[..])), rotation), |((v, f, dtfm), (omega, torque, dtfi))| kick_part::<L::D, ROT>(v, f, dtfm, omega, torque, dtfi));
 }
 
 /// Second half kick of the free grains, or left to the next drift when nothing looks at

@@ -8,6 +8,7 @@ use crate::engine::world::{MotionChange, Stage, View, World};
 use crate::error::Error;
 use crate::physics::boundary::Boundary;
 use crate::physics::contact::ContactLaw;
+use crate::physics::dim::Plane;
 use crate::physics::energy::EnergyRow;
 use crate::physics::particles::Particles;
 use crate::physics::walls::Wall;
@@ -79,7 +80,8 @@ impl<L: ContactLaw> Simulation<L> {
     }
 }
 
-impl<L: ContactLaw> Simulation<L> {
+/// The plane's protocols (space has none yet: issue 30).
+impl<L: ContactLaw<D = Plane>> Simulation<L> {
     /// Change the walls' motion and control and gravity, between two steps. The grains'
     /// pending half kick is given first. A wall's prescribed motion is a drive: the
     /// kinetic energy the balance counts for it (a loaded wall's y motion) changes by what
@@ -162,7 +164,9 @@ pub trait Engine: Send {
     }
 }
 
-impl<L: ContactLaw> Engine for Simulation<L> {
+/// What observers, outputs and studies drive: a run in the plane (a run in space is a
+/// [`Simulation`] of a law of space, driven directly until its outputs exist).
+impl<L: ContactLaw<D = Plane>> Engine for Simulation<L> {
     fn step(&mut self) -> Result<(), Error> {
         Simulation::step(self)
     }

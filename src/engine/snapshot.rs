@@ -90,7 +90,7 @@ fn radii_masses(r: &[f64], m: &[f64]) -> u32 {
     h.finalize()
 }
 
-impl<L: ContactLaw> Simulation<L> {
+impl<L: ContactLaw<D = crate::physics::dim::Plane>> Simulation<L> {
     /// The evolving state, encoded (postcard).
     pub fn save(&self) -> Vec<u8> {
         let w = &self.world;

@@ -16,28 +16,35 @@ use crate::physics::material::PairTable;
 use crate::physics::particles::Particles;
 use crate::physics::walls::Wall;
 
+/// A contact law's dimension ([`Plane`] or [`crate::physics::dim::Space`]).
+pub type DimOf<L> = <L as ContactLaw>::D;
+/// A vector of a contact law's dimension, m (m/s, N).
+pub type VectorOf<L> = <DimOf<L> as Dim>::Vector<f64>;
+/// A spin (torque) of a contact law's dimension, rad/s (N m).
+pub type SpinOf<L> = <DimOf<L> as Dim>::Spin<f64>;
 /// A contact law's state of one contact ([`Held`]: tangential and rolling).
-pub type State<L> = Held<<L as ContactLaw>::Tang, <L as ContactLaw>::Roll>;
+pub type State<L> = Held<<L as ContactLaw>::Tang, <L as ContactLaw>::Roll, f64, DimOf<L>>;
 /// The rolling torque's part of a contact's energy memory under a contact law.
-pub type RollEnergy<L> = <<L as ContactLaw>::Roll as Rolling>::Energy;
+pub type RollEnergy<L> = <<L as ContactLaw>::Roll as Rolling<DimOf<L>>>::Energy;
 /// History type of a contact law.
-pub type Hist<L> = ContactHistory<State<L>, RollEnergy<L>>;
+pub type Hist<L> = ContactHistory<State<L>, RollEnergy<L>, DimOf<L>>;
 
-/// Everything that evolves.
+/// Everything that evolves, in the contact law's dimension (`L::D`: the plane or space).
 pub struct World<L: ContactLaw> {
-    pub p: Particles,
-    pub boundary: Boundary,
+    pub p: Particles<L::D>,
+    pub boundary: Boundary<L::D>,
     pub law: L,
     pub pair_table: PairTable,
-    pub pairs: PairList<State<L>, RollEnergy<L>>,
-    pub walls: Vec<Wall>,
+    pub pairs: PairList<State<L>, RollEnergy<L>, L::D>,
+    pub walls: Vec<Wall<L::D>>,
     /// History of each free grain against each flat wall: `wall_hist[wall][grain]`.
     pub wall_hist: Vec<Vec<Hist<L>>>,
     /// Whether each free grain is touching each flat wall: `wall_active[wall][grain]`.
     pub wall_active: Vec<Vec<bool>>,
-    pub neighbours: Neighbours,
+    pub neighbours: Neighbours<L::D>,
     pub ledger: EnergyLedger,
-    pub gravity: Vec2,
+    /// Gravity, m/s^2.
+    pub gravity: VectorOf<L>,
     /// Time step, s.
     pub dt: f64,
     /// Steps done.
@@ -51,9 +58,9 @@ pub struct World<L: ContactLaw> {
     /// The threads the per-grain stages and the contact stage may use.
     pub threads: crate::kernels::threads::Threads,
     /// The half-kick factors of the integrator.
-    pub kick: KickFactors,
+    pub kick: KickFactors<L::D>,
     /// The region the grains must stay in ([`crate::engine::domain`]).
-    pub domain: crate::engine::domain::Domain,
+    pub domain: crate::engine::domain::Domain<L::D>,
     /// What the build knew that helps diagnose a failed run.
     pub context: crate::engine::domain::Context,
     /// How many of the first grains have zero forces (and torques) already this step:
@@ -113,7 +120,7 @@ impl<L: ContactLaw> World<L> {
                 continue;
             }
             let (i, j) = (i as usize, j as usize);
-            let dn = p.r[i] + p.r[j] - self.boundary.image(p.x[i] - p.x[j]).norm();
+            let dn = p.r[i] + p.r[j] - <L::D as Dim>::norm(self.boundary.image(p.x[i] - p.x[j]));
             if dn > 0.0 {
                 let pm = self.pair_table.get(p.material[i] as usize, p.material[j] as usize);
                 let (un, ut) = self.law.stored_energy(pm, list.consts[k].r_star, list.consts[k].sqrt_m_star, dn, e.fte_prev);
@@ -136,13 +143,14 @@ impl<L: ContactLaw> World<L> {
             }
             let scale = row.put_in();
             if scale > 0.0 && row.residual_j.abs() > MAX_RESIDUAL * scale {
-                let fastest = (0..p.n_free).max_by(|&a, &b| p.v[a].norm_squared().total_cmp(&p.v[b].norm_squared())).unwrap_or(0);
+                let speed2 = |i: usize| <L::D as Dim>::norm_squared(p.v[i]);
+                let fastest = (0..p.n_free).max_by(|&a, &b| speed2(a).total_cmp(&speed2(b))).unwrap_or(0);
                 return Err(self.unstable(format!(
                     "the energy balance no longer closes: residual {:.3e} J is {:.1}% of the energy put in ({:.3e} J); the fastest grain, {fastest}, moves at {:.3e} m/s",
                     row.residual_j,
                     100.0 * row.residual_j.abs() / scale,
                     scale,
-                    p.v[fastest].norm()
+                    speed2(fastest).sqrt()
                 )));
             }
         }
@@ -152,21 +160,23 @@ impl<L: ContactLaw> World<L> {
     /// An error naming the first free grain whose position, velocity, spin or force is not
     /// finite (or whose kinetic energy overflows), or a wall whose state is not.
     pub fn check_finite(&self) -> Result<(), Error> {
+        type D<L> = DimOf<L>;
         let p = &self.p;
-        let x_ok = |i: usize| p.x[i].x.is_finite() && p.x[i].y.is_finite();
-        let v_ok = |i: usize| p.v[i].norm_squared().is_finite();
-        let w_ok = |i: usize| p.omega[i].is_finite() && (p.omega[i] * p.omega[i]).is_finite();
+        let x_ok = |i: usize| D::<L>::flat(std::slice::from_ref(&p.x[i])).iter().all(|c| c.is_finite());
+        let v_ok = |i: usize| D::<L>::norm_squared(p.v[i]).is_finite();
+        // A spin's square overflows (or is NaN) when a component is not finite.
+        let w_ok = |i: usize| D::<L>::spin_dot(p.omega[i], p.omega[i]).is_finite();
         if let Some(i) = (0..p.n_free).find(|&i| !(x_ok(i) && v_ok(i) && w_ok(i))) {
             // Each quantity by value if it is finite, else in words: a diagnosis holds no
             // number that is not one.
             let say = |ok: bool, v: String| if ok { v } else { "not finite".to_string() };
-            let (x, v, w) = (p.x[i], p.v[i], p.omega[i]);
-            let x = say(x_ok(i), format!("[{}, {}]", x.x.shown(), x.y.shown()));
-            let v = say(v_ok(i), format!("[{}, {}]", v.x.shown(), v.y.shown()));
-            let w = say(w_ok(i), w.shown());
+            let x = say(x_ok(i), shown_components(D::<L>::flat(std::slice::from_ref(&p.x[i]))));
+            let v = say(v_ok(i), shown_components(D::<L>::flat(std::slice::from_ref(&p.v[i]))));
+            let w = D::<L>::spin_flat(std::slice::from_ref(&p.omega[i]));
+            let w = say(w_ok(i), if let [w] = w { w.shown() } else { shown_components(w) });
             return Err(self.unstable_at(format!("grain {i} has a non-finite position, velocity or spin (x = {x} m, v = {v} m/s, omega = {w} rad/s)"), Some(i)));
         }
-        if let Some(w) = self.walls.iter().find(|w| !(w.y.is_finite() && w.v.norm_squared().is_finite() && w.force.norm_squared().is_finite())) {
+        if let Some(w) = self.walls.iter().find(|w| !(w.y.is_finite() && D::<L>::norm_squared(w.v).is_finite() && D::<L>::norm_squared(w.force).is_finite())) {
             return Err(self.unstable_at(format!("the {} wall's position, velocity or force is not finite", w.name), None));
         }
         Ok(())
@@ -181,7 +191,12 @@ impl<L: ContactLaw> World<L> {
         let who = |i: usize| if i < p.n_free { format!("grain {i}") } else { format!("grain {i} (glued to a rough wall)") };
         Err(match fault {
             Fault::Left { grain, at } => self.unstable_at(
-                format!("{} left the domain: it is at ({:.6e}, {:.6e}) m, moving at {:.3e} m/s", who(grain), at.x, at.y, p.v[grain].norm()),
+                format!(
+                    "{} left the domain: it is at ({}) m, moving at {:.3e} m/s",
+                    who(grain),
+                    at.iter().map(|c| format!("{c:.6e}")).collect::<Vec<_>>().join(", "),
+                    <L::D as Dim>::norm(p.v[grain])
+                ),
                 Some(grain),
             ),
             Fault::Jumped { grain, moved } => self.unstable_at(
@@ -190,7 +205,7 @@ impl<L: ContactLaw> World<L> {
                     who(grain),
                     moved / self.p.r[..p.n_free].iter().cloned().fold(f64::INFINITY, f64::min),
                     crate::engine::consistency::MAX_STEP_MOVE,
-                    p.v[grain].norm()
+                    <L::D as Dim>::norm(p.v[grain])
                 ),
                 Some(grain),
             ),
@@ -213,6 +228,11 @@ impl<L: ContactLaw> World<L> {
             advice: self.context.likely_cause(&self.p, &self.walls, self.gravity, self.dt, self.time(), grain, self.domain.max_step),
         }
     }
+}
+
+/// Numbers as `[a, b]` (or `[a, b, c]`), each [`Shown`].
+fn shown_components(c: &[f64]) -> String {
+    format!("[{}]", c.iter().map(|c| c.shown()).collect::<Vec<_>>().join(", "))
 }
 
 /// A change of the walls' motion and control and of gravity between two steps: what a

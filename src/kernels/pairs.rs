@@ -6,11 +6,12 @@
 use crate::kernels::threads::Threads;
 use crate::physics::contact::EnergyMemory;
 use crate::physics::contact::rolling::RollingEnergy;
+use crate::physics::dim::{Dim, Plane};
 use crate::physics::energy::EnergySums;
 
 /// The Verlet list and the history of each listed pair.
 #[derive(Clone, Debug, Default)]
-pub struct PairList<H, X = ()> {
+pub struct PairList<H, X = (), D: Dim = Plane> {
     /// Listed pairs, i < j, sorted (set by [`PairList::replace`] only).
     pub pairs: Pairs,
     /// What each pair's kernel would otherwise divide out at every step, parallel to `pairs`.
@@ -23,7 +24,7 @@ pub struct PairList<H, X = ()> {
     pub hist: Vec<H>,
     /// Energy memory of each pair, parallel to `pairs` when `keep_energy`, else empty
     /// (`X`: its rolling torque's part, `()` without rolling resistance).
-    pub energy: Vec<EnergyMemory<f64, X>>,
+    pub energy: Vec<EnergyMemory<f64, X, D>>,
     /// True while the pair is (or was at the previous step) touching, parallel to `pairs`.
     pub active: Vec<bool>,
     /// Keep the energy memory (the run has the energy ledger on).
@@ -31,15 +32,15 @@ pub struct PairList<H, X = ()> {
     /// The arrays of the list before the last rebuild, kept for the next one to fill:
     /// new arrays at every rebuild cost their page faults again (a quarter of the
     /// rebuild's time at 20 000 grains).
-    pub(crate) spare: Spare<H, X>,
+    pub(crate) spare: Spare<H, X, D>,
 }
 
 /// Spare per-pair arrays ([`PairList::replace`] swaps them with the list's).
 #[derive(Clone, Debug, Default)]
-pub(crate) struct Spare<H, X = ()> {
+pub(crate) struct Spare<H, X = (), D: Dim = Plane> {
     hist: Vec<H>,
     active: Vec<bool>,
-    energy: Vec<EnergyMemory<f64, X>>,
+    energy: Vec<EnergyMemory<f64, X, D>>,
 }
 
 /// The constants of a listed pair, computed once per neighbour-list build.
@@ -53,7 +54,7 @@ pub struct PairConst {
     pub inv_r_min: f64,
 }
 
-impl<H: Copy + Default + Send + Sync, X: RollingEnergy<f64>> PairList<H, X> {
+impl<H: Copy + Default + Send + Sync, X: RollingEnergy<f64, D::Spin<f64>>, D: Dim> PairList<H, X, D> {
     /// Replace the pairs, keeping the history of every pair that stays listed, and
     /// compute their constants from the radii `r` and masses `m`; on `threads`, each
     /// taking a stretch of the new list (the old list is sorted too, so a stretch finds
@@ -87,7 +88,7 @@ impl<H: Copy + Default + Send + Sync, X: RollingEnergy<f64>> PairList<H, X> {
     /// length, checked) and their states, parallel to them; the constants are computed
     /// again from the radii `r` and masses `m`, as the build computed them. An error
     /// says what does not fit.
-    pub fn restore(&mut self, pairs: Vec<[u32; 2]>, hist: Vec<H>, active: Vec<bool>, energy: Vec<EnergyMemory<f64, X>>, r: &[f64], m: &[f64]) -> Result<(), String> {
+    pub fn restore(&mut self, pairs: Vec<[u32; 2]>, hist: Vec<H>, active: Vec<bool>, energy: Vec<EnergyMemory<f64, X, D>>, r: &[f64], m: &[f64]) -> Result<(), String> {
         let np = pairs.len();
         if hist.len() != np || active.len() != np || energy.len() != if self.keep_energy { np } else { 0 } {
             return Err(format!("its pair list has {np} pairs but {} histories, {} flags and {} energy memories", hist.len(), active.len(), energy.len()));
@@ -135,19 +136,19 @@ fn constants(new: &[[u32; 2]], consts: &mut [PairConst], reach: &mut [f64], r: &
 }
 
 /// What the old list carries over to the new one: its pairs (sorted) and their states.
-struct Carried<'a, H, X> {
+struct Carried<'a, H, X, D: Dim> {
     pairs: &'a [[u32; 2]],
     hist: &'a [H],
     active: &'a [bool],
     /// Empty without the energy ledger.
-    energy: &'a [EnergyMemory<f64, X>],
+    energy: &'a [EnergyMemory<f64, X, D>],
 }
 
-impl<H: Copy + Default, X: RollingEnergy<f64>> Carried<'_, H, X> {
+impl<H: Copy + Default, X: RollingEnergy<f64, D::Spin<f64>>, D: Dim> Carried<'_, H, X, D> {
     /// The states of the pairs of the sorted stretch `new`: those listed before keep
     /// theirs, the others start afresh (every entry is written). The energy sums start
     /// at 0 in the new list: the ledger has taken the old list's.
-    fn carry(&self, new: &[[u32; 2]], hist: &mut [H], active: &mut [bool], mut energy: Option<&mut [EnergyMemory<f64, X>]>) {
+    fn carry(&self, new: &[[u32; 2]], hist: &mut [H], active: &mut [bool], mut energy: Option<&mut [EnergyMemory<f64, X, D>]>) {
         let old = self.pairs;
         let mut k = new.first().map_or(0, |first| old.partition_point(|p| p < first));
         for (m, p) in new.iter().enumerate() {

@@ -20,9 +20,15 @@ use crate::physics::lanes::{LANES, Lanes, gather};
 /// the stretches between them one after the other, so that no pair pays for a test; the
 /// CPU-specific sweeps (AVX-512, AVX2) mask their lanes. No branch per pair, and the
 /// lists keep their length from step to step (no clearing).
+/// In the plane the CPU-specific sweep (where the build has one) runs in front of the
+/// portable one; in space the portable sweep runs alone ([`sort_pairs_portable`]).
 #[allow(clippy::too_many_arguments)]
-pub fn sort_pairs(x: &[Vec2], boundary: &Boundary, pairs: CheckedPairs<'_>, reach: &[f64], active: &[bool], skip: &[u32], touching: &mut Vec<u32>, sep: &mut Vec<Vec2>, released: &mut Vec<u32>) -> (usize, usize) {
-    sort_pairs_with(true, x, boundary, pairs, reach, active, skip, touching, sep, released)
+#[inline]
+pub fn sort_pairs<D: Dim>(x: &[D::Vector<f64>], boundary: &Boundary<D>, pairs: CheckedPairs<'_>, reach: &[f64], active: &[bool], skip: &[u32], touching: &mut Vec<u32>, sep: &mut Vec<D::Vector<f64>>, released: &mut Vec<u32>) -> (usize, usize) {
+    if let (Some(x), Some(b), Some(sep)) = (D::plane_vectors(x), boundary.plane(), D::plane_vec_mut(sep)) {
+        return sort_pairs_with(true, x, &b, pairs, reach, active, skip, touching, sep, released);
+    }
+    sort_pairs_portable(x, boundary, pairs, reach, active, skip, touching, sep, released)
 }
 
 /// The CPU-specific sweep the build has, as its width (pairs per step) and loop: eight
@@ -232,7 +238,7 @@ mod tests {
     fn skipped_pairs_leave_the_rest_of_the_sweep_unchanged() {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
         let n = 300;
-        let boundary = Boundary::periodic_x(0.0, 1.0);
+        let boundary = Boundary::<crate::physics::dim::Plane>::periodic_x(0.0, 1.0);
         let x: Vec<Vec2> = (0..n).map(|_| Vec2::new(rng.random::<f64>(), 0.3 * rng.random::<f64>())).collect();
         let r: Vec<f64> = (0..n).map(|_| 0.01 + 0.01 * rng.random::<f64>()).collect();
         let mut list: PairList<f64> = PairList::default();

@@ -37,6 +37,12 @@ impl<D: Dim> Boundary<D> {
     pub fn inv_period(&self) -> f64 {
         self.inv_period
     }
+    /// The same cell as the plane's, when `D` is the plane (`None` in space): for the
+    /// plane's wide kernels ([`Dim::plane_vectors`]).
+    #[inline(always)]
+    pub fn plane(&self) -> Option<Boundary<Plane>> {
+        (D::D == 2).then_some(Boundary { x_min: self.x_min, period: self.period, inv_period: self.inv_period, z_min: 0.0, z_period: 0.0, z_inv_period: 0.0, dim: PhantomData })
+    }
     /// Periodic in x.
     pub fn is_periodic(&self) -> bool {
         self.period > 0.0

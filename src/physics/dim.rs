@@ -104,6 +104,17 @@ pub trait Dim: Copy + Default + Debug + Send + Sync + 'static {
     /// (rad/s). In the plane every spin is along z, perpendicular to every normal, so the
     /// second turn is none.
     fn turn<R: Real>(f: Self::Vector<R>, n_prev: Self::Vector<R>, n: Self::Vector<R>, spin_sum: Self::Twist<R>, dt: R) -> Self::Vector<R>;
+    /// The plane's own arrays when `Self` is the plane, `None` in space. Where the plane
+    /// has hand-written wide kernels (AVX2, AVX-512: the contact sweep, the drift and
+    /// the kicks), code written once over `D` hands them its arrays through these and
+    /// runs its own loop in space; the choice is made at compile time.
+    fn plane_vectors(v: &[Self::Vector<f64>]) -> Option<&[Vec2]>;
+    fn plane_vectors_mut(v: &mut [Self::Vector<f64>]) -> Option<&mut [Vec2]>;
+    fn plane_vec_mut(v: &mut Vec<Self::Vector<f64>>) -> Option<&mut Vec<Vec2>>;
+    fn plane_spins(w: &[Self::Spin<f64>]) -> Option<&[f64]>;
+    fn plane_spins_mut(w: &mut [Self::Spin<f64>]) -> Option<&mut [f64]>;
+    /// The number of components of a spin: 1 in the plane, 3 in space.
+    const SPIN: usize;
 }
 
 /// Two dimensions: grains in the xy-plane spinning about z (every engine today).
@@ -158,6 +169,27 @@ macro_rules! nalgebra_vector {
 impl Dim for Plane {
     const D: usize = 2;
     const NAME: &'static str = "plane";
+    const SPIN: usize = 1;
+    #[inline(always)]
+    fn plane_vectors(v: &[Vec2]) -> Option<&[Vec2]> {
+        Some(v)
+    }
+    #[inline(always)]
+    fn plane_vectors_mut(v: &mut [Vec2]) -> Option<&mut [Vec2]> {
+        Some(v)
+    }
+    #[inline(always)]
+    fn plane_vec_mut(v: &mut Vec<Vec2>) -> Option<&mut Vec<Vec2>> {
+        Some(v)
+    }
+    #[inline(always)]
+    fn plane_spins(w: &[f64]) -> Option<&[f64]> {
+        Some(w)
+    }
+    #[inline(always)]
+    fn plane_spins_mut(w: &mut [f64]) -> Option<&mut [f64]> {
+        Some(w)
+    }
     type Vector<R: Real> = Vector2<R>;
     type Spin<R: Real> = R;
     type Twist<R: Real> = ();
@@ -233,6 +265,22 @@ impl Dim for Plane {
 impl Dim for Space {
     const D: usize = 3;
     const NAME: &'static str = "space";
+    const SPIN: usize = 3;
+    fn plane_vectors(_: &[Vector3<f64>]) -> Option<&[Vec2]> {
+        None
+    }
+    fn plane_vectors_mut(_: &mut [Vector3<f64>]) -> Option<&mut [Vec2]> {
+        None
+    }
+    fn plane_vec_mut(_: &mut Vec<Vector3<f64>>) -> Option<&mut Vec<Vec2>> {
+        None
+    }
+    fn plane_spins(_: &[Vector3<f64>]) -> Option<&[f64]> {
+        None
+    }
+    fn plane_spins_mut(_: &mut [Vector3<f64>]) -> Option<&mut [f64]> {
+        None
+    }
     type Vector<R: Real> = Vector3<R>;
     type Spin<R: Real> = Vector3<R>;
     type Twist<R: Real> = Vector3<R>;

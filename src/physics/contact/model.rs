@@ -13,7 +13,7 @@ use super::rolling::{Cdt, Epsd2, InLanes, NoRolling, Rolling, RollingEnergy, Rol
 use super::damping::{Damping, LinearRestitution, TsujiFit, Undamped, Viscoelastic};
 use super::normal::{Hertz, Hooke, Normal};
 use super::tangential::{Frictionless, IncrementalForce, Tangential, TangentialForce, TangentialInput, TotalDisplacement, TotalForceCap, TotalForceCapSpringKept, MicroSlip};
-use crate::physics::dim::{Dim, Plane, Vec2};
+use crate::physics::dim::{Dim, Plane};
 use crate::physics::energy::{EnergyLedger, EnergySums};
 use crate::physics::lanes::{Real, k, pick};
 use crate::physics::material::PairMaterial;
@@ -290,32 +290,34 @@ impl<N: Normal, Dm: Damping, T: Tangential<D>, C: Cohesion, Rr: Rolling<D>, D: D
 }
 
 /// A contact's energy memory under law `L`.
-pub type Memory<L> = EnergyMemory<f64, <<L as ContactLaw>::Roll as Rolling>::Energy>;
+pub type Memory<L> = EnergyMemory<f64, <<L as ContactLaw>::Roll as Rolling<<L as ContactLaw>::D>>::Energy, <L as ContactLaw>::D>;
 
 /// A contact's state of law `L` as a checkpoint stores it.
-pub type Saved<L> = (<<L as ContactLaw>::Tang as Tangential>::Saved, <<L as ContactLaw>::Roll as Rolling>::Saved);
+pub type Saved<L> = (<<L as ContactLaw>::Tang as Tangential<<L as ContactLaw>::D>>::Saved, <<L as ContactLaw>::Roll as Rolling<<L as ContactLaw>::D>>::Saved);
 
-/// A contact law: the trait the stages are generic over.
+/// A contact law: the trait the stages are generic over. Its dimension `D` is the
+/// world's: a law of the plane runs in a world of the plane, one of space in space.
 pub trait ContactLaw: Copy + Send + Sync + 'static {
+    type D: Dim;
     type Damp: Damping;
-    type Tang: Tangential;
+    type Tang: Tangential<Self::D>;
     type Coh: Cohesion;
-    type Roll: Rolling;
+    type Roll: Rolling<Self::D>;
     fn options(&self) -> ModelOptions;
     /// The elastic energies, normal and tangential (J), a touching contact of materials
     /// `pm`, reduced radius `r_star` (m) and square root of the reduced mass
     /// `sqrt_m_star` (kg^1/2) stores at overlap `dn` (m) with elastic tangential force
     /// `fte` (N) (what the ledger adds for the pairs when it is read).
-    fn stored_energy(&self, pm: &PairMaterial, r_star: f64, sqrt_m_star: f64, dn: f64, fte: Vec2) -> (f64, f64);
+    fn stored_energy(&self, pm: &PairMaterial, r_star: f64, sqrt_m_star: f64, dn: f64, fte: <Self::D as Dim>::Vector<f64>) -> (f64, f64);
     /// The normal law's name and parameters, for `explain` and checkpoints.
     fn normal_label(&self) -> String;
     /// The rolling resistance's name and parameters ("" without).
     fn rolling_label(&self) -> String;
     /// A contact's state as a checkpoint stores it (the same numbers), and back.
-    fn save_state(h: Held<Self::Tang, Self::Roll>) -> Saved<Self> {
+    fn save_state(h: Held<Self::Tang, Self::Roll, f64, Self::D>) -> Saved<Self> {
         (Self::Tang::save(h.0), Self::Roll::save(h.1))
     }
-    fn load_state(s: Saved<Self>) -> Held<Self::Tang, Self::Roll> {
+    fn load_state(s: Saved<Self>) -> Held<Self::Tang, Self::Roll, f64, Self::D> {
         (Self::Tang::load(s.0), Self::Roll::load(s.1))
     }
     /// One line for `explain`.
@@ -510,7 +512,8 @@ impl<N: Normal, Dm: Damping, T: Tangential<D>, C: Cohesion, Rr: Rolling<D>, D: D
     }
 }
 
-impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling> ContactLaw for ContactModel<N, Dm, T, C, Rr> {
+impl<N: Normal, Dm: Damping, T: Tangential<D>, C: Cohesion, Rr: Rolling<D>, D: Dim> ContactLaw for ContactModel<N, Dm, T, C, Rr, D> {
+    type D = D;
     type Damp = Dm;
     type Tang = T;
     type Coh = C;
@@ -519,7 +522,7 @@ impl<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling> ContactLaw
         self.options
     }
     #[inline]
-    fn stored_energy(&self, pm: &PairMaterial, r_star: f64, sqrt_m_star: f64, dn: f64, fte: Vec2) -> (f64, f64) {
+    fn stored_energy(&self, pm: &PairMaterial, r_star: f64, sqrt_m_star: f64, dn: f64, fte: D::Vector<f64>) -> (f64, f64) {
         let st = self.normal.stiffness(pm, r_star, sqrt_m_star, dn);
         Self::elastic(st.kn, st.kt, pm.pulloff * r_star, dn, fte)
     }
