@@ -33,7 +33,8 @@
 //! sheared) with every tangential law: the grains' momentum along z moves only by the
 //! walls' forces along z (1e-12 of the grains' mass times 1 m/s), the grains stay in the
 //! periodic cell and cross its z boundary, the packing is sheared, and the energy
-//! balance closes to second order in the time step (the bound's reason at the test).
+//! balance closes to second order in the time step (the bound's reason at the test);
+//! saved mid-run and restored into a box built afresh, it continues to the bit.
 
 use grainlab::engine::build::{Pipeline, Plan, pipeline};
 use grainlab::engine::domain::{Context, Domain};
@@ -472,4 +473,48 @@ fn a_3d_shear_box_conserves_momentum_along_z_and_closes_its_energy_balance() {
     let half = shear_box_run::<TotalDisplacement>(LeverArm::RadiusMinusHalfOverlap, 0.5e-7);
     eprintln!("residual {first:.2e} at dt, {half:.2e} at dt/2: ratio {:.2}", first / half);
     assert!(first / half > 2.5, "residual {first:e} at dt, {half:e} at dt/2");
+}
+
+/// A 3D shear box saved mid-run (its grains packed and sheared, a final half kick
+/// pending, the general damping carrying its last forces) and restored into a box built
+/// afresh continues as the run that never stopped, to the bit: positions, velocities,
+/// spins, forces, the walls, every term of the ledger. Mutation: the snapshot without
+/// the general damping's carried forces fails (the first step after the restore
+/// integrates its work from other forces).
+fn restored<T: Tangential<Space>>(lever_arm: LeverArm) {
+    let name = <T as Tangential<Space>>::NAME;
+    let mut a = shear_box::<T>(lever_arm, Some(50.0), 1e-7);
+    // Not a multiple of 100, where the watchdog gives the pending kick to check the state.
+    for _ in 0..15_001 {
+        a.advance(false).unwrap();
+    }
+    assert!(a.world.kick.pending.is_some() && a.world.pairs.touching() > 20, "{name}: saved mid-run, with contacts ({}) and a pending kick ({:?})", a.world.pairs.touching(), a.world.kick.pending);
+    let bytes = a.save();
+    let mut b = shear_box::<T>(lever_arm, Some(50.0), 1e-7);
+    b.restore(&bytes).unwrap();
+    for step in 1..=5_000 {
+        let look = step % 1000 == 0;
+        a.advance(look).unwrap();
+        b.advance(look).unwrap();
+        if !look {
+            continue;
+        }
+        let (p, q) = (&a.world.p, &b.world.p);
+        assert!(p.x == q.x && p.v == q.v && p.omega == q.omega && p.f == q.f && p.torque == q.torque, "{name}: the grains differ {step} steps after the restore");
+        for (u, v) in a.world.walls.iter().zip(&b.world.walls) {
+            assert!(u.y == v.y && u.v == v.v && u.force == v.force, "{name}: the {} wall differs {step} steps after the restore", u.name);
+        }
+        assert_eq!(format!("{:?}", a.world.ledger_now()), format!("{:?}", b.world.ledger_now()), "{name}: the ledger {step} steps after the restore");
+    }
+    // A box of another time step is refused by name.
+    let mut c = shear_box::<T>(lever_arm, Some(50.0), 0.5e-7);
+    let refused = c.restore(&bytes).unwrap_err();
+    assert!(refused.contains("time step"), "{refused}");
+}
+
+#[test]
+fn a_3d_shear_box_restored_from_its_checkpoint_continues_to_the_bit() {
+    restored::<TotalDisplacement>(LeverArm::RadiusMinusHalfOverlap);
+    restored::<IncrementalForce>(LeverArm::Yade);
+    restored::<TotalForceCap>(LeverArm::Lammps);
 }

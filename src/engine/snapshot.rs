@@ -1,6 +1,9 @@
 //! A snapshot of everything a simulation carries from one step to the next, so that a
 //! run restored from it continues with the same bits as the run that never stopped
 //! (`grainlab resume`; the checkpoint file around it is [`crate::output::checkpoint`]).
+//! Written once for the plane and space: the grains' vectors and spins are saved as
+//! their dimension has them (in the plane `Vec2` and `f64`, so the plane's checkpoints
+//! keep their bytes).
 //!
 //! What evolves, and so is saved: the grains' positions, velocities, spins, forces and
 //! torques (the forces of the last step feed the next step's first half kick); each
@@ -18,31 +21,33 @@
 //! of the radii and masses. The run has no random generator after the build (the
 //! packing's is used up there), so there is none to save.
 
+use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
 use crate::engine::simulation::Simulation;
-use crate::engine::world::{PendingKick, State, Zeroed};
+use crate::engine::world::{PendingKick, SpinOf, State, VectorOf, Zeroed};
 use crate::physics::contact::model::{Memory, Saved};
 use crate::physics::contact::{ContactHistory, ContactLaw};
-use crate::physics::dim::Vec2;
 use crate::physics::energy::EnergyLedger;
 use crate::physics::walls::Control;
 
-/// One wall's evolving state.
+/// One wall's evolving state (`V`: a vector of the world's dimension).
 #[derive(Serialize, Deserialize)]
-struct WallState {
+struct WallState<V> {
     control: Control,
     y: f64,
     x_shift: f64,
-    v: Vec2,
-    force: Vec2,
-    force_prev: Vec2,
+    v: V,
+    force: V,
+    force_prev: V,
 }
 
 /// A simulation's evolving state; `S` is a contact's state as saved and `E` its energy
-/// memory ([`crate::physics::contact::model::Saved`], [`crate::physics::contact::model::Memory`]).
+/// memory ([`crate::physics::contact::model::Saved`], [`crate::physics::contact::model::Memory`]),
+/// `V` a vector and `W` a spin of the world's dimension (in the plane `Vec2` and `f64`:
+/// the plane's checkpoints keep their bytes).
 #[derive(Serialize, Deserialize)]
-struct Snapshot<S, E> {
+struct Snapshot<S, E, V, W> {
     /// What must match the simulation it is restored into.
     model: String,
     stages: Vec<String>,
@@ -52,12 +57,12 @@ struct Snapshot<S, E> {
     /// CRC-32 of the radii and masses, as bytes.
     radii_masses: u32,
     step: u64,
-    x: Vec<Vec2>,
-    v: Vec<Vec2>,
-    omega: Vec<f64>,
-    f: Vec<Vec2>,
-    torque: Vec<f64>,
-    walls: Vec<WallState>,
+    x: Vec<V>,
+    v: Vec<V>,
+    omega: Vec<W>,
+    f: Vec<V>,
+    torque: Vec<W>,
+    walls: Vec<WallState<V>>,
     /// `wall_hist[wall][grain]`, `wall_active[wall][grain]`.
     wall_hist: Vec<Vec<(S, E)>>,
     wall_active: Vec<Vec<bool>>,
@@ -65,12 +70,12 @@ struct Snapshot<S, E> {
     hist: Vec<S>,
     energy: Vec<E>,
     active: Vec<bool>,
-    at_build: Vec<Vec2>,
+    at_build: Vec<V>,
     builds: u64,
     moved_far: bool,
     ledger: EnergyLedger,
     initial_energy: f64,
-    gravity: Vec2,
+    gravity: V,
     max_overlap: (f64, usize, usize),
     pending: Option<(f64, bool)>,
     zeroed: (usize, usize),
@@ -90,7 +95,12 @@ fn radii_masses(r: &[f64], m: &[f64]) -> u32 {
     h.finalize()
 }
 
-impl<L: ContactLaw<D = crate::physics::dim::Plane>> Simulation<L> {
+/// In the plane and in space: the grains' vectors and spins are saved as they are.
+impl<L: ContactLaw> Simulation<L>
+where
+    VectorOf<L>: Serialize + DeserializeOwned,
+    SpinOf<L>: Serialize + DeserializeOwned,
+{
     /// The evolving state, encoded (postcard).
     pub fn save(&self) -> Vec<u8> {
         let w = &self.world;
@@ -133,7 +143,7 @@ impl<L: ContactLaw<D = crate::physics::dim::Plane>> Simulation<L> {
     /// scene. An error says what does not fit (found before anything changes, but for
     /// the pair list's and the stages' own checks: the simulation is then not to be run).
     pub fn restore(&mut self, bytes: &[u8]) -> Result<(), String> {
-        let s: Snapshot<Saved<L>, Memory<L>> = postcard::from_bytes(bytes).map_err(|e| format!("its state does not decode for this contact model ({e})"))?;
+        let s: Snapshot<Saved<L>, Memory<L>, VectorOf<L>, SpinOf<L>> = postcard::from_bytes(bytes).map_err(|e| format!("its state does not decode for this contact model ({e})"))?;
         let w = &self.world;
         let n = w.p.len();
         let stages: Vec<String> = self.stage_names().iter().map(|n| stage_kind(n).to_string()).collect();
