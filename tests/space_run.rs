@@ -35,6 +35,10 @@
 //! periodic cell and cross its z boundary, the packing is sheared, and the energy
 //! balance closes to second order in the time step (the bound's reason at the test);
 //! saved mid-run and restored into a box built afresh, it continues to the bit.
+//!
+//! Behind the engine's interface (`Engine<Space>`): a sphere thrown along every axis
+//! falls as the closed form, a change of gravity between two steps acts from the next
+//! force on, and a saved engine continues to the bit in another.
 
 use grainlab::engine::build::{Pipeline, Plan, pipeline};
 use grainlab::engine::domain::{Context, Domain};
@@ -517,4 +521,56 @@ fn a_3d_shear_box_restored_from_its_checkpoint_continues_to_the_bit() {
     restored::<TotalDisplacement>(LeverArm::RadiusMinusHalfOverlap);
     restored::<IncrementalForce>(LeverArm::Yade);
     restored::<TotalForceCap>(LeverArm::Lammps);
+}
+
+/// A run in space behind the engine's interface (`Engine<Space>`, what observers,
+/// outputs and studies drive): a sphere thrown along every axis under gravity falls as
+/// `x0 + v0 t + g t^2 / 2` (to 1e-12 of its travel: velocity Verlet is exact under a
+/// constant force, the rest is rounding over 2000 steps); a change of motion between two
+/// steps turns gravity along x, and the sphere's velocity then grows along x by `g t`
+/// (but for the first half kick, which has the last step's force);
+/// the view reads the world's grains; the engine's state saved and restored into another
+/// continues to the bit.
+#[test]
+fn a_run_in_space_behind_the_engine_interface_falls_as_the_closed_form() {
+    use grainlab::engine::simulation::Engine;
+    use grainlab::engine::world::MotionChange;
+    let (x0, v0, g) = (Vector3::new(1e-3, 2e-3, -3e-3), Vector3::new(0.3, -0.2, 0.5), Vector3::new(0.0, -9.81, 0.0));
+    let make = || -> Box<dyn Engine<Space>> {
+        let mut p = Particles::<Space>::default();
+        p.push(x0, v0, Vector3::new(10.0, -20.0, 30.0), 1e-3, 1e-5, 4e-12, 0);
+        p.n_free = 1;
+        Box::new(assemble::<TotalDisplacement, Space>(p, Vec::new(), Boundary::open(), g, 1e-6, None, Material::default(), LeverArm::RadiusMinusHalfOverlap))
+    };
+    let mut e = make();
+    for _ in 0..2000 {
+        e.step().unwrap();
+    }
+    let t = e.time();
+    let want = x0 + v0 * t + g * (0.5 * t * t);
+    let got = e.view().particles.x[0];
+    assert!((got - want).norm() < 1e-12 * (v0 * t).norm(), "{got:?} against {want:?}");
+    assert_eq!(e.particles().omega[0], Vector3::new(10.0, -20.0, 30.0), "no torque, no change of spin");
+    // Gravity along x from here on.
+    e.change_motion(&MotionChange { gravity: Some(nalgebra::Vector2::new(2.0, 0.0)), ..Default::default() });
+    let v1 = e.particles().v[0];
+    let saved = e.save();
+    for _ in 0..1000 {
+        e.step().unwrap();
+    }
+    let (dt, h) = (e.time() - t, 1e-6);
+    let dv = e.particles().v[0] - v1;
+    // The first half kick after the change still has the old force (velocity Verlet's
+    // forces are those of the last step's end): dv = g_new (T - h/2) + g_old h/2.
+    let want = Vector3::new(2.0 * (dt - 0.5 * h), 0.0, 0.0) + g * (0.5 * h);
+    assert!((dv - want).norm() < 1e-12, "{dv:?} over {dt} s, want {want:?}");
+    e.health().unwrap();
+    // The saved state continues to the bit in another engine of the same build.
+    let mut f = make();
+    f.change_motion(&MotionChange { gravity: Some(nalgebra::Vector2::new(2.0, 0.0)), ..Default::default() });
+    f.restore(&saved).unwrap();
+    for _ in 0..1000 {
+        f.step().unwrap();
+    }
+    assert_eq!((f.particles().x[0], f.particles().v[0]), (e.particles().x[0], e.particles().v[0]));
 }

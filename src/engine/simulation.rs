@@ -8,7 +8,10 @@ use crate::engine::world::{MotionChange, Stage, View, World};
 use crate::error::Error;
 use crate::physics::boundary::Boundary;
 use crate::physics::contact::ContactLaw;
-use crate::physics::dim::Plane;
+use crate::engine::world::{SpinOf, VectorOf};
+use crate::physics::dim::{Dim, Plane};
+use serde::Serialize;
+use serde::de::DeserializeOwned;
 use crate::physics::energy::EnergyRow;
 use crate::physics::particles::Particles;
 use crate::physics::walls::Wall;
@@ -80,13 +83,14 @@ impl<L: ContactLaw> Simulation<L> {
     }
 }
 
-/// The plane's protocols (space has none yet: issue 30).
-impl<L: ContactLaw<D = Plane>> Simulation<L> {
+impl<L: ContactLaw> Simulation<L> {
     /// Change the walls' motion and control and gravity, between two steps. The grains'
     /// pending half kick is given first. A wall's prescribed motion is a drive: the
     /// kinetic energy the balance counts for it (a loaded wall's y motion) changes by what
     /// the drive does, so that change is booked as the walls' work and the balance stays
     /// closed across the change. The glued grains take the new velocity in the next drift.
+    /// A change is the plane's protocols' (x and y; in space its gravity lies in x-y:
+    /// protocols in space are for later, issue 30).
     pub fn change_motion(&mut self, c: &MotionChange) {
         use crate::physics::walls::Control;
         let w = &mut self.world;
@@ -96,34 +100,37 @@ impl<L: ContactLaw<D = Plane>> Simulation<L> {
             if let Some(control) = m.control {
                 wall.control = control;
                 if control == Control::Fixed {
-                    wall.v.y = 0.0;
+                    wall.v[1] = 0.0;
                 }
             }
             if let Some(vx) = m.velocity_x {
-                wall.v.x = vx;
+                wall.v[0] = vx;
             }
             if let Some(vy) = m.velocity_y {
-                wall.v.y = vy;
+                wall.v[1] = vy;
             }
             if w.energy {
                 w.ledger.walls += wall.kinetic() - before;
             }
         }
         if let Some(g) = c.gravity {
-            w.gravity = g;
+            let mut lifted = <L::D as Dim>::zero();
+            (lifted[0], lifted[1]) = (g.x, g.y);
+            w.gravity = lifted;
         }
     }
 }
 
-/// A running simulation behind one dynamic call per step, whatever its contact model.
-pub trait Engine: Send {
+/// A running simulation behind one dynamic call per step, whatever its contact model, in
+/// the plane (`D = Plane`, the default: every scene so far) or in space.
+pub trait Engine<D: Dim = Plane>: Send {
     fn step(&mut self) -> Result<(), Error>;
     /// One step, after which nothing looks at the grains' velocities or spins (`look`
     /// false) before the next: see [`Simulation::advance`].
     fn advance(&mut self, look: bool) -> Result<(), Error>;
-    fn particles(&self) -> &Particles;
-    fn walls(&self) -> &[Wall];
-    fn boundary(&self) -> Boundary;
+    fn particles(&self) -> &Particles<D>;
+    fn walls(&self) -> &[Wall<D>];
+    fn boundary(&self) -> Boundary<D>;
     fn energy_row(&self) -> EnergyRow;
     fn steps(&self) -> u64;
     fn time(&self) -> f64;
@@ -157,29 +164,32 @@ pub trait Engine: Send {
     fn probe(&self) -> &crate::engine::world::Probe;
     /// A read-only view of the state, what observers and outputs read: the contacts are
     /// there when they are of this very step.
-    fn view(&self) -> View<'_> {
+    fn view(&self) -> View<'_, D> {
         let probe = self.probe();
         let contacts = if probe.step == self.steps() && probe.step > 0 { &probe.contacts[..] } else { &[] };
         View { particles: self.particles(), contacts, walls: self.walls(), boundary: self.boundary(), time: self.time() }
     }
 }
 
-/// What observers, outputs and studies drive: a run in the plane (a run in space is a
-/// [`Simulation`] of a law of space, driven directly until its outputs exist).
-impl<L: ContactLaw<D = Plane>> Engine for Simulation<L> {
+/// What observers, outputs and studies drive, in the plane or in space.
+impl<L: ContactLaw> Engine<L::D> for Simulation<L>
+where
+    VectorOf<L>: Serialize + DeserializeOwned,
+    SpinOf<L>: Serialize + DeserializeOwned,
+{
     fn step(&mut self) -> Result<(), Error> {
         Simulation::step(self)
     }
     fn advance(&mut self, look: bool) -> Result<(), Error> {
         Simulation::advance(self, look)
     }
-    fn particles(&self) -> &Particles {
+    fn particles(&self) -> &Particles<L::D> {
         &self.world.p
     }
-    fn walls(&self) -> &[Wall] {
+    fn walls(&self) -> &[Wall<L::D>] {
         &self.world.walls
     }
-    fn boundary(&self) -> Boundary {
+    fn boundary(&self) -> Boundary<L::D> {
         self.world.boundary
     }
     fn energy_row(&self) -> EnergyRow {

@@ -272,13 +272,13 @@ pub const MAX_RESIDUAL: f64 = 0.5;
 /// A read-only view of a world's state at one time: what observers and outputs read
 /// (they see neither the World nor the Engine).
 #[derive(Clone, Copy)]
-pub struct View<'a> {
-    pub particles: &'a Particles,
+pub struct View<'a, D: Dim = Plane> {
+    pub particles: &'a Particles<D>,
     /// The contacts of the last step that recorded them (empty unless the scene asks
-    /// for contacts and the run wanted them at this step).
+    /// for contacts and the run wanted them at this step; always in space so far).
     pub contacts: &'a [ContactRecord],
-    pub walls: &'a [Wall],
-    pub boundary: Boundary,
+    pub walls: &'a [Wall<D>],
+    pub boundary: Boundary<D>,
     /// Simulated time, s.
     pub time: f64,
 }
