@@ -13,6 +13,10 @@
 //!
 //! The arrays are appended raw (binary, little endian, 64-bit sizes), which ParaView and
 //! the `vtk` library read; a frame is about a third of its ASCII size and exact.
+//!
+//! A run in space writes the same grains' frames ([`VtkSeries::frame_of`]), its spins
+//! and torques as 3-vectors (in the plane their one component about z); its contacts
+//! are not recorded yet (issue 30).
 
 use std::fmt::Write as _;
 
@@ -21,6 +25,7 @@ use crate::error::Error;
 use crate::observe::packing::{grain_contacts, grain_stress_volumes};
 use crate::output::folder::OutFolder;
 use crate::physics::contact::Partner;
+use crate::physics::dim::Dim;
 
 /// The frames of a run, in the `frames` sub-folder of its output folder.
 pub struct VtkSeries {
@@ -87,6 +92,28 @@ fn xyz(v: &crate::physics::dim::Vec2) -> [f64; 3] {
     [v.x, v.y, 0.0]
 }
 
+/// Vectors of the plane or space as VTK's points: three components each (z = 0 in the
+/// plane).
+fn points<D: Dim>(v: &[D::Vector<f64>]) -> impl Iterator<Item = f64> + '_ {
+    D::flat(v).chunks_exact(D::D).flat_map(|c| [c[0], c[1], if D::D == 3 { c[2] } else { 0.0 }])
+}
+
+/// The last line of defence (the run checks the state before a frame): no frame holds
+/// a number that is not finite.
+fn all_finite<D: Dim>(e: &View<D>) -> Result<(), Error> {
+    let p = e.particles;
+    let vector = |v: &D::Vector<f64>| D::flat(std::slice::from_ref(v)).iter().all(|c| c.is_finite());
+    let spin = |w: &D::Spin<f64>| D::spin_flat(std::slice::from_ref(w)).iter().all(|c| c.is_finite());
+    match (0..p.len()).find(|&i| !(vector(&p.x[i]) && vector(&p.v[i]) && vector(&p.f[i]) && spin(&p.omega[i]) && spin(&p.torque[i]))) {
+        Some(i) => Err(Error::Other(format!("frame at t = {:e} s not written: grain {i}'s state is not finite", e.time))),
+        None => Ok(()),
+    }
+}
+
+fn finite(v: &crate::physics::dim::Vec2) -> bool {
+    v.x.is_finite() && v.y.is_finite()
+}
+
 /// The contacts' file of a grains frame (`frames/grains_NNNNN.vtp`), `ext` `vtp` or `csv`.
 fn contacts_file(frame: &str, ext: &str) -> String {
     frame.replacen("grains_", "contacts_", 1).replace(".vtp", &format!(".{ext}"))
@@ -128,40 +155,17 @@ impl VtkSeries {
     /// folder's manifest); with `contacts` (recorded at this step, [`View::contacts`]),
     /// the contacts' `.vtp` and `.csv` too, and the grains' contacts and stresses.
     pub fn frame(&mut self, e: &View, contacts: bool, folder: &mut OutFolder) -> Result<(), Error> {
-        let p = e.particles;
-        let n = p.len();
-        // The last line of defence (the run checks the state before a frame): no frame
-        // holds a number that is not finite.
-        let finite = |v: &crate::physics::dim::Vec2| v.x.is_finite() && v.y.is_finite();
-        if let Some(i) = (0..n).find(|&i| !(finite(&p.x[i]) && finite(&p.v[i]) && finite(&p.f[i]) && p.omega[i].is_finite() && p.torque[i].is_finite())) {
-            return Err(Error::Other(format!("frame at t = {:e} s not written: grain {i}'s state is not finite", e.time)));
-        }
+        all_finite(e)?;
         if let Some(c) = e.contacts.iter().find(|c| !(finite(&c.point) && finite(&c.branch) && c.normal_force.is_finite() && finite(&c.tangential_force) && c.overlap.is_finite())) {
             return Err(Error::Other(format!("frame at t = {:e} s not written: a contact of grain {}'s is not finite", e.time, c.i)));
         }
-        let mut g = Vtp::new();
-        g.tag(&format!("    <Piece NumberOfPoints=\"{n}\" NumberOfVerts=\"{n}\" NumberOfLines=\"0\" NumberOfStrips=\"0\" NumberOfPolys=\"0\">"));
-        g.tag("      <Points>");
-        g.f64s("position_m", 3, p.x.iter().flat_map(xyz));
-        g.tag("      </Points>");
-        g.tag("      <PointData Scalars=\"radius_m\">");
-        g.i64s("id", 0..n as i64);
-        g.f64s("radius_m", 1, p.r.iter().cloned());
-        g.f64s("velocity_m_s", 3, p.v.iter().flat_map(xyz));
-        g.f64s("spin_rad_s", 1, p.omega.iter().cloned());
-        g.f64s("force_n", 3, p.f.iter().flat_map(xyz));
-        g.f64s("torque_n_m", 1, p.torque.iter().cloned());
-        g.f64s("material", 1, p.material.iter().map(|&m| m as f64));
-        g.f64s("wall_grain", 1, (0..n).map(|i| if i < p.n_free { 0.0 } else { 1.0 }));
-        if contacts {
-            g.i64s("contacts", grain_contacts(e).into_iter().map(i64::from));
-            // A 3x3 tensor, row a column b: positions along a, forces along b.
-            g.f64s("stress_volume_n_m", 9, grain_stress_volumes(e).into_iter().flat_map(|s| [s[0], s[1], 0.0, s[2], s[3], 0.0, 0.0, 0.0, 0.0]));
-        }
-        g.tag("      </PointData>");
-        g.cells("Verts", n, 1);
-        let name = format!("frames/grains_{:05}.vtp", self.frames.len());
-        folder.write(&name, &g.bytes())?;
+        let name = self.grains(e, folder, |g| {
+            if contacts {
+                g.i64s("contacts", grain_contacts(e).into_iter().map(i64::from));
+                // A 3x3 tensor, row a column b: positions along a, forces along b.
+                g.f64s("stress_volume_n_m", 9, grain_stress_volumes(e).into_iter().flat_map(|s| [s[0], s[1], 0.0, s[2], s[3], 0.0, 0.0, 0.0, 0.0]));
+            }
+        })?;
         if contacts {
             let file = contacts_file(&name, "vtp");
             folder.write(&file, &contacts_vtp(e))?;
@@ -170,6 +174,44 @@ impl VtkSeries {
         }
         self.frames.push((e.time, name));
         self.index(folder)
+    }
+
+    /// Write one frame of grains in the plane or in space (spheres: positions,
+    /// velocities, forces as 3-vectors; in space spins and torques too, in the plane
+    /// their one component about z) and rewrite the `.pvd` index. Contacts are the
+    /// plane's ([`VtkSeries::frame`]).
+    pub fn frame_of<D: Dim>(&mut self, e: &View<D>, folder: &mut OutFolder) -> Result<(), Error> {
+        all_finite(e)?;
+        let name = self.grains(e, folder, |_| ())?;
+        self.frames.push((e.time, name));
+        self.index(folder)
+    }
+
+    /// Write the grains' file of the next frame (checked finite), `extra` adding point
+    /// arrays after the grains' own; its name.
+    fn grains<D: Dim>(&self, e: &View<D>, folder: &mut OutFolder, extra: impl FnOnce(&mut Vtp)) -> Result<String, Error> {
+        let p = e.particles;
+        let n = p.len();
+        let mut g = Vtp::new();
+        g.tag(&format!("    <Piece NumberOfPoints=\"{n}\" NumberOfVerts=\"{n}\" NumberOfLines=\"0\" NumberOfStrips=\"0\" NumberOfPolys=\"0\">"));
+        g.tag("      <Points>");
+        g.f64s("position_m", 3, points::<D>(&p.x));
+        g.tag("      </Points>");
+        g.tag("      <PointData Scalars=\"radius_m\">");
+        g.i64s("id", 0..n as i64);
+        g.f64s("radius_m", 1, p.r.iter().cloned());
+        g.f64s("velocity_m_s", 3, points::<D>(&p.v));
+        g.f64s("spin_rad_s", D::SPIN, D::spin_flat(&p.omega).iter().cloned());
+        g.f64s("force_n", 3, points::<D>(&p.f));
+        g.f64s("torque_n_m", D::SPIN, D::spin_flat(&p.torque).iter().cloned());
+        g.f64s("material", 1, p.material.iter().map(|&m| m as f64));
+        g.f64s("wall_grain", 1, (0..n).map(|i| if i < p.n_free { 0.0 } else { 1.0 }));
+        extra(&mut g);
+        g.tag("      </PointData>");
+        g.cells("Verts", n, 1);
+        let name = format!("frames/grains_{:05}.vtp", self.frames.len());
+        folder.write(&name, &g.bytes())?;
+        Ok(name)
     }
 
     /// Write the `.pvd` indexes of the frames.
