@@ -9,6 +9,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use clap::{Parser, Subcommand};
 use grainlab::Error;
 use grainlab::build_limited;
+use grainlab::physics::dim::Space;
+use grainlab::scene::Dimension;
 use grainlab::error::exit;
 use grainlab::scene::limits::Limits;
 use grainlab::output::{csv::CsvSeries, folder::OutFolder};
@@ -293,6 +295,19 @@ fn report_run(report: RunReport, out: Option<&std::path::Path>) -> Result<(), Er
     }
 }
 
+/// Run a built scene (in the plane or in space): the pipeline first, then the run with
+/// its stop flag, and the report.
+fn run_in<D: grainlab::study::run::Running>(scene: &grainlab::Scene, built: grainlab::Built<D>, mut opts: RunOptions, out: Option<&std::path::Path>) -> Result<(), Error> {
+    note!("{}", built.explain());
+    opts.stop = Some(interrupt_flag()?);
+    report_run(run_report(scene, built, &opts)?, out)
+}
+
+/// `explain`'s lines: the pipeline, then every effect.
+fn explain<D: grainlab::physics::dim::Dim>(built: &grainlab::Built<D>) -> Result<(), Error> {
+    say!("{}\n{}", built.explain(), built.explain_effects().trim_end())
+}
+
 fn execute(cli: Cli) -> Result<(), Error> {
     let limits = cli.memory_budget.map_or_else(Limits::machine, Limits::with_memory);
     let load_scene = |arg: &str| grainlab::scene::builtin::load(arg, &limits);
@@ -306,11 +321,12 @@ fn execute(cli: Cli) -> Result<(), Error> {
                 // Refused before a long build; the run claims the folder when it starts.
                 OutFolder::check(dir, overwrite)?;
             }
-            let built = build_limited(&scene, threads, &limits)?;
-            note!("{}", built.explain());
-            let opts = RunOptions { out: out.clone(), overwrite, progress: !quiet, duration, limits, stop: Some(interrupt_flag()?), command: std::env::args().collect(), checkpoint_every, ..RunOptions::default() };
+            let opts = RunOptions { out: out.clone(), overwrite, progress: !quiet, duration, limits: limits.clone(), stop: None, command: std::env::args().collect(), checkpoint_every, ..RunOptions::default() };
             let _ = run_scene;
-            report_run(run_report(&scene, built, &opts)?, out.as_deref())
+            match scene.dimension {
+                Dimension::Two => run_in(&scene, build_limited(&scene, threads, &limits)?, opts, out.as_deref()),
+                Dimension::Three => run_in(&scene, grainlab::study::accuracy::build_in::<Space>(&scene, threads, &limits)?, opts, out.as_deref()),
+            }
         }
         Command::Resume { dir, quiet, threads } => {
             let opts = RunOptions { progress: !quiet, limits, stop: Some(interrupt_flag()?), command: std::env::args().collect(), ..RunOptions::default() };
@@ -322,8 +338,10 @@ fn execute(cli: Cli) -> Result<(), Error> {
         }
         Command::Explain { scene } => {
             let scene = load_scene(&scene)?;
-            let built = build_limited(&scene, 1, &limits)?;
-            say!("{}\n{}", built.explain(), built.explain_effects().trim_end())
+            match scene.dimension {
+                Dimension::Two => explain(&build_limited(&scene, 1, &limits)?),
+                Dimension::Three => explain(&grainlab::study::accuracy::build_in::<Space>(&scene, 1, &limits)?),
+            }
         }
         Command::Export { code, scene, out, overwrite, bench, explain_fields } => {
             if explain_fields {

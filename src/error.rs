@@ -107,6 +107,11 @@ macro_rules! shown_as_display {
 }
 shown_as_display!(usize, u64, u32, i64, &str, String);
 
+/// Numbers as `a, b` (or `a, b, c`), each [`Shown`]: a point's coordinates in a message.
+pub fn shown_joined(c: &[f64]) -> String {
+    c.iter().map(|c| c.shown()).collect::<Vec<_>>().join(", ")
+}
+
 impl<T: Shown> Shown for &T {
     fn shown(&self) -> String {
         (**self).shown()

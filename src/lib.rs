@@ -99,4 +99,4 @@ pub use observe::stress::{ShearSummary, WallAverager};
 pub use output::summary::Summary;
 pub use scene::Scene;
 pub use study::run::{RunOptions, run_scene};
-pub use study::{build, build_limited, build_with};
+pub use study::{build, build_in, build_limited, build_with};

@@ -65,8 +65,8 @@ fn pair(a: (f64, Material), b: (f64, Material), shape: GrainShape, v: f64, vy0: 
     s.materials = vec![a.1, b.1];
     s.grain_shape = shape;
     s.grains = Grains::List(vec![
-        GrainSpec { x: [-a.0 - gap / 2.0, 0.0], v: [v * mb / (ma + mb), vy0], omega: w[0], r: a.0, material: 0 },
-        GrainSpec { x: [b.0 + gap / 2.0, 0.0], v: [-v * ma / (ma + mb), 0.0], omega: w[1], r: b.0, material: 1 },
+        GrainSpec { x: [-a.0 - gap / 2.0, 0.0].into(), v: [v * mb / (ma + mb), vy0].into(), omega: w[0].into(), r: a.0, material: 0 },
+        GrainSpec { x: [b.0 + gap / 2.0, 0.0].into(), v: [-v * ma / (ma + mb), 0.0].into(), omega: w[1].into(), r: b.0, material: 1 },
     ]);
     s.time_step.rule = TimeStepRule::Fixed { dt };
     s.duration = 2.0 * gap / v + 3.0 * tc;
@@ -251,7 +251,7 @@ const MICROSLIP_GROSS: f64 = 1e-6;
 /// sliding gives for them: `(dvt, r dw, -mu dvn sign, -kappa mu dvn sign)`.
 fn gross_sliding(s: &Scene, imp: &ImpactSummary, kappa: f64, mu: f64) -> (f64, f64, f64, f64) {
     let Grains::List(g) = &s.grains else { unreachable!() };
-    let (v0, w0, r) = (g[0].v, g[0].omega, g[0].r);
+    let (v0, w0, r) = (g[0].v, g[0].omega.z(), g[0].r);
     let slip = (v0[0] + r * w0).signum();
     let dvn = imp.rebound_normal_velocity_m_s - v0[1];
     let dvt = imp.rebound_tangential_velocity_m_s - v0[0];

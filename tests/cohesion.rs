@@ -144,7 +144,7 @@ fn a_hertz_contact_with_dmt_holds_below_its_pull_off_force_and_parts_above() {
     let g = |f: f64| [0.0, f * f0 / m];
     // The gravity stage is built when the scene pulls at all: start at half the
     // pull-off force (10.5 steps of approach lose nothing that matters).
-    s.gravity = g(0.5);
+    s.gravity = g(0.5).into();
     let fs = [0.5, 0.8, 0.9, 0.95, 0.97, 0.98, 0.99];
     let t_c = 2.868 * (m * m / (r * e_star * e_star * 0.01)).powf(0.2);
     s.duration = (fs.len() as f64 + 2.0) * 40.0 * t_c;

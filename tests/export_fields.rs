@@ -245,6 +245,8 @@ fn candidates_of(kind: &Kind, v: &Value) -> Vec<Vec<Value>> {
                 Kind::Choice(units) if !v.is_string() => units.iter().map(|u| vec![json!(u)]).collect(),
                 Kind::Integer | Kind::Number if !v.is_number() => Vec::new(),
                 Kind::Choice(_) if !v.is_string() => Vec::new(),
+                // A spin about z stays a number (three components are a 3D scene's).
+                Kind::Numbers if !v.is_array() => Vec::new(),
                 k => candidates_of(k, v),
             })
             .collect(),
@@ -279,13 +281,19 @@ fn candidates_of(kind: &Kind, v: &Value) -> Vec<Vec<Value>> {
 /// A scene grainlab accepts and builds (a change that fails here is no change to export).
 fn valid(v: &Value) -> Option<Scene> {
     let s = Scene::from_json(&v.to_string()).ok()?;
-    grainlab::build(&s).ok()?;
+    match s.dimension {
+        grainlab::scene::Dimension::Two => drop(grainlab::build(&s).ok()?),
+        grainlab::scene::Dimension::Three => drop(grainlab::build_in::<grainlab::physics::dim::Space>(&s, 1, &Default::default()).ok()?),
+    }
     Some(s)
 }
 
 /// What the engine does with a scene: dt, steps, and every grain's and wall's state after
 /// 60 steps (long enough for the impacts' contacts to begin, 10.5 steps in).
 fn engine_run(s: &Scene) -> Vec<f64> {
+    if s.dimension == grainlab::scene::Dimension::Three {
+        return engine_run_in_space(s);
+    }
     let mut b = grainlab::build(s).unwrap();
     let (steps, _) = grainlab::engine::timestep::schedule(s.duration, b.time_step.dt_s, s.output.samples);
     let mut out = vec![b.time_step.dt_s, steps as f64];
@@ -305,6 +313,26 @@ fn engine_run(s: &Scene) -> Vec<f64> {
         if w.load_y() != 0.0 {
             out.push(w.mass);
         }
+    }
+    out
+}
+
+/// [`engine_run`] of a 3D scene: dt, steps, and every grain's position, velocity and
+/// spin (three components each) after 60 steps.
+fn engine_run_in_space(s: &Scene) -> Vec<f64> {
+    let mut b = grainlab::build_in::<grainlab::physics::dim::Space>(s, 1, &Default::default()).unwrap();
+    let (steps, _) = grainlab::engine::timestep::schedule(s.duration, b.time_step.dt_s, s.output.samples);
+    let mut out = vec![b.time_step.dt_s, steps as f64];
+    for _ in 0..60 {
+        if b.engine.step().is_err() {
+            out.push(f64::NAN);
+            break;
+        }
+    }
+    let p = b.engine.particles();
+    for i in 0..p.len() {
+        out.extend(p.x[i].iter().chain(p.v[i].iter()).chain(p.omega[i].iter()).copied());
+        out.extend([p.r[i], p.m[i]]);
     }
     out
 }
@@ -368,6 +396,14 @@ fn bases(dir: &Path) -> Vec<Base> {
     let focus = |name, s: &Scene, only| Base { name, scene: json_of(s), only, variant_of: None };
     let variant = |name, s: &Scene, of, leaf, only| Base { name, scene: json_of(s), only, variant_of: Some((of, leaf)) };
     let mut out = vec![base("collision", &collision), base("oblique", &oblique), base("shear", &shear)];
+    // The dimension given (2 is left out of written scenes): set to 3, the same grains in
+    // space, which every export refuses by name.
+    // (Its analysis none: the impact observer is the plane's, and a 3D scene asking for it
+    // is refused when read.)
+    let mut planar = json_of(&collision);
+    planar["dimension"] = json!(2);
+    planar["analysis"] = json!("none");
+    out.push(Base { name: "collision, dimension given", scene: planar, only: &["dimension"], variant_of: None });
 
     // Two materials (one restitution, as YADE needs), the second grain of the second.
     let mut s = collision.clone();
@@ -506,7 +542,7 @@ fn bases(dir: &Path) -> Vec<Base> {
     s.model.general_damping = Some(0.1);
     out.push(variant("collision-damped", &s, "collision", "model.general_damping", &["model.general_damping"]));
     let mut s = collision.clone();
-    s.gravity = [0.0, -9.81];
+    s.gravity = [0.0, -9.81].into();
     out.push(variant("collision-gravity", &s, "collision", "gravity", &["gravity"]));
     let mut s = collision.clone();
     s.grain_shape = grainlab::physics::dim::GrainShape::Disk { thickness: 2e-3 };
@@ -548,7 +584,7 @@ fn bases(dir: &Path) -> Vec<Base> {
             bottom: WallChange { velocity_x: Some(-0.5), velocity_y: Some(0.0), control: Some(ControlSpec::Fixed) },
             top: WallChange { velocity_x: Some(0.5), velocity_y: Some(1e-3), control: Some(ControlSpec::Fixed) },
         },
-        gravity: Some([0.0, 0.0]),
+        gravity: Some([0.0, 0.0].into()),
         samples: Some(3),
         frames: Some(1),
         average: false,
@@ -774,8 +810,19 @@ fn one_value_fields_admit_no_other_value() {
     s["stages"][1]["walls"]["bottom"]["control"] = json!({"pressure": 1e5});
     let e = Scene::from_json(&s.to_string()).expect_err("a loaded bottom wall is refused");
     assert!(e.to_string().contains("stages[1].walls.bottom.control"), "{e}");
+    // A 3D scene's own fields are refused in a 2D scene (and a 3D scene's export as a
+    // whole, by its dimension: the_exporter_keeps_every_decision).
+    let mut s = json_of(&grainlab::scene::builtin::shear_cell(60, 0.004));
+    s["domain"]["periodic_z"] = json!([0.0, 0.004]);
+    let e = Scene::from_json(&s.to_string()).expect_err("a periodic z in 2D is refused");
+    assert!(e.to_string().contains("domain.periodic_z") && e.to_string().contains("dimension"), "{e}");
+    let mut s = json_of(&grainlab::scene::builtin::shear_cell(60, 0.004));
+    s["grains"]["pack"]["z"] = json!([0.0, 0.004]);
+    let e = Scene::from_json(&s.to_string()).expect_err("a packing's z range in 2D is refused");
+    assert!(e.to_string().contains("grains.pack.z") && e.to_string().contains("dimension"), "{e}");
+    let space_only = ["domain.periodic_z", "grains.pack.z"];
     for f in FIELDS.iter().filter(|f| f.liggghts.one_value.is_some() || f.yade.one_value.is_some()) {
-        assert!(f.path.starts_with("walls.bottom.control") || f.path.starts_with("stages[].walls.bottom.control"), "{}: a one-value field this test does not try", f.path);
+        assert!(f.path.starts_with("walls.bottom.control") || f.path.starts_with("stages[].walls.bottom.control") || space_only.contains(&f.path), "{}: a one-value field this test does not try", f.path);
     }
 }
 

@@ -122,11 +122,11 @@ fn grains_far_apart_within_the_bounds_run_in_memory_proportional_to_their_number
     s.analysis = grainlab::scene::Analysis::None;
     if let Grains::List(g) = &mut s.grains {
         let mut far = g[1].clone();
-        far.x = [500.0, 0.0];
-        far.v = [0.0, 0.0];
+        far.x = [500.0, 0.0].into();
+        far.v = [0.0, 0.0].into();
         for k in 0..50 {
             let mut q = far.clone();
-            q.x = [0.01 * k as f64, 0.5];
+            q.x = [0.01 * k as f64, 0.5].into();
             g.push(q);
         }
         g.push(far);
@@ -333,8 +333,12 @@ fn a_load_the_grains_cannot_carry_or_the_wall_cannot_follow_is_refused() {
 #[test]
 fn a_parse_error_names_the_field_path() {
     // Old build: `trailing characters at line 1 column 589`.
+    // Three numbers are a 3D scene's vector: refused in 2D, naming the field and the way.
     let msg = changed("collision", |s| s["gravity"] = json!([0, -9.81, 0])).unwrap_err().to_string();
-    assert_names(&msg, &["at `gravity`", "more elements than the field takes"]);
+    assert_names(&msg, &["gravity = 3 numbers", "2 numbers [x, y] in a 2D scene", "\"dimension\": 3"]);
+    // Four are no vector at all: refused when read, at the field's path.
+    let msg = changed("collision", |s| s["gravity"] = json!([0, -9.81, 0, 1])).unwrap_err().to_string();
+    assert_names(&msg, &["at `gravity`", "invalid length 4", "[x, y, z]"]);
     let msg = changed("collision", |s| s["grains"]["list"][1]["r"] = "big".into()).unwrap_err().to_string();
     assert_names(&msg, &["at `grains.list[1].r`", "expected f64"]);
 }

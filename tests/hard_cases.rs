@@ -101,8 +101,8 @@ fn sliding_grain(tangential: TangentialSpec, v0: f64, duration: f64) -> Scene {
     let dn = (3.0 * m * g / (4.0 * e * R.sqrt())).powf(2.0 / 3.0);
     let mut s = oblique(mat, R, 1.0, 0.0, tangential, 50.0);
     s.name = "rolling".into();
-    s.grains = Grains::List(vec![GrainSpec { x: [0.0, R - dn], v: [v0, 0.0], omega: 0.0, r: R, material: 0 }]);
-    s.gravity = [0.0, -g];
+    s.grains = Grains::List(vec![GrainSpec { x: [0.0, R - dn].into(), v: [v0, 0.0].into(), omega: 0.0.into(), r: R, material: 0 }]);
+    s.gravity = [0.0, -g].into();
     s.duration = duration;
     s.analysis = Analysis::None;
     s.model.lever_arm = LeverArm::RadiusMinusHalfOverlap;
@@ -364,7 +364,7 @@ fn an_impact_on_a_grain_of_density_1e300_reports_finite_numbers() {
     if let Grains::List(g) = &mut s.grains {
         g[1].material = 1;
     }
-    s.gravity = [-1.0, 0.0];
+    s.gravity = [-1.0, 0.0].into();
     let i = impact(&s);
     let t = s.duration;
     assert!(i.momentum_error_rel.is_finite() && i.momentum_error_rel > 0.0 && i.momentum_error_rel <= 2.0 * t * 1.01, "{i:?} (2 g t = {})", 2.0 * t);

@@ -60,7 +60,7 @@ fn rel(expected: f64, actual: f64) -> f64 {
 fn on_floor(grain: Material, floor: Option<Material>, r: f64, y: f64, v: [f64; 2], w: f64, dt: f64) -> Scene {
     let mut s = on_rigid_plane(grain.clone(), Default::default(), r, 1.0, 0.0, 0.0, 100.0, TangentialSpec::TotalDisplacement);
     s.materials[1] = floor.unwrap_or(Material { name: "floor".into(), ..grain });
-    s.grains = Grains::List(vec![GrainSpec { x: [0.0, y], v, omega: w, r, material: 0 }]);
+    s.grains = Grains::List(vec![GrainSpec { x: [0.0, y].into(), v: v.into(), omega: w.into(), r, material: 0 }]);
     s.time_step.rule = TimeStepRule::Fixed { dt };
     s.analysis = Analysis::None;
     s.duration = 1.0;
@@ -83,7 +83,7 @@ fn freefall() {
     // touched.) Measured 1.5e-13.
     let mut s = on_floor(material(7e10, 0.33, 2700.0, 1.0, 0.0), None, 0.0025, 0.05, [0.0, 0.0], 0.0, 1e-5);
     s.model.normal = NormalLaw::HookeStiffness { kn: 1e4, kt: 1e4 };
-    s.gravity = [0.0, -9.81];
+    s.gravity = [0.0, -9.81].into();
     let st = run_steps(&s, 8000);
     let t = st.t;
     assert!(rel(0.05 - 0.5 * 9.81 * t * t, st.x[0].y) < 1e-9, "z {} at t {t}", st.x[0].y);
@@ -113,8 +113,8 @@ fn collision_restitution() {
     let mut cases = Vec::new();
     let mut s = head_on(al(0.5, 0.4), 0.0025, 4.0, 1000.0);
     if let Grains::List(g) = &mut s.grains {
-        g[0].omega = 22.0;
-        g[1].omega = -22.0;
+        g[0].omega = 22.0.into();
+        g[1].omega = (-22.0).into();
     }
     cases.push(("dem01-hertz-twosphere", s, 0.5, 2.0, 1e-8, 0.02));
     for e in [0.2, 0.8] {
@@ -127,8 +127,8 @@ fn collision_restitution() {
     cases.push(("dem09-normal-3d", s, 0.9, 1.0, 2e-4, 0.015));
     let mut s = head_on(al(0.5, 0.4), 0.0025, 4.0, 1000.0);
     if let Grains::List(g) = &mut s.grains {
-        g[0].omega = 22.0;
-        g[1].omega = -22.0;
+        g[0].omega = 22.0.into();
+        g[1].omega = (-22.0).into();
     }
     s.model.damping = DampingSpec::TsujiSqrt2;
     s.model.tangential = TangentialSpec::TotalForceCap;
@@ -259,8 +259,8 @@ fn spin_impact_and_spin_no_friction() {
     let grain = material(7e10, 0.33, 2700.0, 0.5, 0.4);
     let mut s = head_on(grain, 0.0025, 0.4, 1000.0);
     if let Grains::List(g) = &mut s.grains {
-        g[0].omega = 22.86;
-        g[1].omega = -22.86;
+        g[0].omega = 22.86.into();
+        g[1].omega = (-22.86).into();
     }
     s.time_step.rule = TimeStepRule::Fixed { dt: 1e-7 };
     s.analysis = Analysis::None;
@@ -284,8 +284,8 @@ fn oblique_impact_pair() {
         let grain = material(7e11, 0.33, 2700.0, e, mu);
         let mut s = head_on(grain, r, 2.0, 1000.0);
         s.grains = Grains::List(vec![
-            GrainSpec { x: [-0.00255, -1e-4], v: [vn, vt], omega: 0.0, r, material: 0 },
-            GrainSpec { x: [0.00255, 1e-4], v: [-vn, -vt], omega: 0.0, r, material: 0 },
+            GrainSpec { x: [-0.00255, -1e-4].into(), v: [vn, vt].into(), omega: 0.0.into(), r, material: 0 },
+            GrainSpec { x: [0.00255, 1e-4].into(), v: [-vn, -vt].into(), omega: 0.0.into(), r, material: 0 },
         ]);
         s.time_step.rule = TimeStepRule::Fixed { dt: 1e-8 };
         s.analysis = Analysis::None;
@@ -313,7 +313,7 @@ fn slip_transient_and_slip_cessation() {
     let m = 4.0 / 3.0 * PI * r * r * r * 2700.0;
     let mut s = on_floor(material(7e10, 0.33, 2700.0, 1.0, 0.4), None, r, r - m / 1e4, [1.4, 0.0], 0.0, 1e-5);
     s.model.normal = NormalLaw::HookeStiffness { kn: 1e4, kt: 2.8e3 };
-    s.gravity = [0.0, -1.0];
+    s.gravity = [0.0, -1.0].into();
     let st = run_steps(&s, 40000);
     let t = st.t;
     assert!(rel(1.4 - 0.4 * t, st.v[0].x) < 0.01, "u {} at {t}", st.v[0].x);
@@ -322,7 +322,7 @@ fn slip_transient_and_slip_cessation() {
     let m = 4.0 / 3.0 * PI * r * r * r;
     let mut s = on_floor(material(1e4, 0.3, 1.0, 0.5, 0.5), None, r, r - m / 1e4, [1.0, 0.0], 0.0, 2e-4);
     s.model.normal = NormalLaw::HookeStiffness { kn: 1e4, kt: 2.0 / 7.0 * 1e4 };
-    s.gravity = [0.0, -1.0];
+    s.gravity = [0.0, -1.0].into();
     let st = run_steps(&s, 4500);
     assert!(rel(5.0 / 7.0, st.v[0].x) < 0.005, "u {}", st.v[0].x);
     assert!(rel(5.0 / 7.0 / r, -st.w[0]) < 0.005, "w {}", st.w[0]);
@@ -349,7 +349,7 @@ fn incline_rolling() {
         let dn = (m * cos_t / (4.0 / 3.0 * pm.e_star * r.sqrt())).powf(2.0 / 3.0);
         let mut s = on_floor(grain, None, r, r - dn, [0.0, 0.0], 0.0, 1e-5);
         s.model.rolling = RollingSpec::Sds { stiffness: 1e4, damping: 0.0 };
-        s.gravity = [sin_t, -cos_t];
+        s.gravity = [sin_t, -cos_t].into();
         let st = run_steps(&s, steps);
         let a = 5.0 / 7.0 * (sin_t - mur * cos_t);
         if a > 0.0 {
@@ -376,7 +376,7 @@ fn terminal_velocity_wall_restitution_and_pulloff_dmt() {
         w.bottom.y = Some(-0.01);
         w.top.y = Some(1.0);
     }
-    s.gravity = [0.0, -9.81];
+    s.gravity = [0.0, -9.81].into();
     s.model.general_damping = Some(1e-7 / m);
     // No contact in the run: the time step is not the contact's.
     s.time_step.allow_unstable = true;

@@ -30,8 +30,8 @@ fn rolling_grain(law: RollingSpec, shape: GrainShape, v0: f64, duration: f64) ->
     let m = shape.mass(R, grain.density);
     let e_star = PairMaterial::mix(&grain, &s.materials[1]).e_star;
     let dn = (m * G / (4.0 / 3.0 * e_star * R.sqrt())).powf(2.0 / 3.0);
-    s.grains = Grains::List(vec![GrainSpec { x: [0.0, R - dn], v: [v0, 0.0], omega: -v0 / R, r: R, material: 0 }]);
-    s.gravity = [0.0, -G];
+    s.grains = Grains::List(vec![GrainSpec { x: [0.0, R - dn].into(), v: [v0, 0.0].into(), omega: (-v0 / R).into(), r: R, material: 0 }]);
+    s.gravity = [0.0, -G].into();
     s.model.rolling = law;
     s.analysis = Analysis::None;
     s.duration = duration;
@@ -113,7 +113,7 @@ fn the_energy_balance_closes_with_rolling_resistance_in_the_shear_cell() {
 fn rolling_resistance_is_refused_where_it_is_not_compiled_and_by_the_codes_without_it() {
     use grainlab::workbench::export::{Code, export_files};
     let (mut s, _, _) = rolling_grain(RollingSpec::Epsd2, GrainShape::SphereInPlane, 0.01, 1e-3);
-    s.gravity = [0.0, 0.0];
+    s.gravity = [0.0, 0.0].into();
     let refusal = |s: &grainlab::Scene, code: Code| export_files(s, code, false, &Default::default()).err().map(|e| e.to_string());
     // LIGGGHTS has CDT and EPSD2, LAMMPS SDS, YADE none: each refuses the others by name.
     assert_eq!(refusal(&s, Code::Liggghts), None);

@@ -555,7 +555,7 @@ fn a_run_in_space_behind_the_engine_interface_falls_as_the_closed_form() {
     assert!((got - want).norm() < 1e-12 * (v0 * t).norm(), "{got:?} against {want:?}");
     assert_eq!(e.particles().omega[0], Vector3::new(10.0, -20.0, 30.0), "no torque, no change of spin");
     // Gravity along x from here on.
-    e.change_motion(&MotionChange { gravity: Some(nalgebra::Vector2::new(2.0, 0.0)), ..Default::default() });
+    e.change_motion(&MotionChange { gravity: Some([2.0, 0.0].into()), ..Default::default() });
     let v1 = e.particles().v[0];
     let saved = e.save();
     for _ in 0..1000 {
@@ -570,7 +570,7 @@ fn a_run_in_space_behind_the_engine_interface_falls_as_the_closed_form() {
     e.health().unwrap();
     // The saved state continues to the bit in another engine of the same build.
     let mut f = make();
-    f.change_motion(&MotionChange { gravity: Some(nalgebra::Vector2::new(2.0, 0.0)), ..Default::default() });
+    f.change_motion(&MotionChange { gravity: Some([2.0, 0.0].into()), ..Default::default() });
     f.restore(&saved).unwrap();
     for _ in 0..1000 {
         f.step().unwrap();

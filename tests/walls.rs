@@ -13,7 +13,7 @@ fn a_grain_settles_on_a_flat_wall_under_gravity() {
     // per contact (the O(dt^2) residual is 4.6e-4 at 50 steps, so 1/16 of it here).
     let g = Material { restitution: 0.3, ..Material::default() };
     let mut s = oblique(g, 1e-3, 0.1, 0.0, TangentialSpec::TotalDisplacement, 200.0);
-    s.gravity = [0.0, -9.81];
+    s.gravity = [0.0, -9.81].into();
     s.analysis = Analysis::None;
     s.duration = 0.05;
     let built = grainlab::build(&s).unwrap();

@@ -20,6 +20,7 @@ use crate::physics::contact::model::*;
 use crate::physics::contact::tangential::Tangential;
 use crate::physics::contact::{ContactHistory, ContactModel, ModelOptions};
 use crate::physics::dim::{Dim, Plane, Space, Vec2};
+use nalgebra::Vector3;
 use crate::physics::energy::EnergyLedger;
 use crate::physics::material::{PairMaterial, PairTable};
 use crate::physics::particles::Particles;
@@ -28,13 +29,13 @@ use crate::scene::grains::read_grain_file;
 use crate::scene::limits::{Limits, MemoryEstimate};
 use crate::scene::pack::relaxed_packing;
 use crate::physics::contact::rolling::Sds;
-use crate::scene::{Analysis, ControlSpec, DampingSpec, Grains, RollingSpec, Scene, SurfaceSpec, TangentialSpec, TimeStepRule};
+use crate::scene::{Analysis, ControlSpec, Dimension, DampingSpec, Grains, RollingSpec, Scene, SurfaceSpec, TangentialSpec, TimeStepRule};
 
 /// What was built, besides the engine.
-pub struct Built {
-    pub engine: Box<dyn Engine>,
+pub struct Built<D: Dim = Plane> {
+    pub engine: Box<dyn Engine<D>>,
     pub time_step: TimeStepInfo,
-    /// Depth that turns wall forces into stresses, m.
+    /// Depth that turns wall forces into stresses, m (in space the cell's z length).
     pub depth: f64,
     /// Length of the periodic cell (or of the packing), m.
     pub length: f64,
@@ -44,7 +45,7 @@ pub struct Built {
     pub stages: Option<String>,
 }
 
-impl Built {
+impl<D: Dim> Built<D> {
     /// Every effect, on or off, why, and its measured cost ([`Effects::table`]).
     pub fn explain_effects(&self) -> String {
         self.effects.table(&crate::engine::effects::cost_runs(), &crate::engine::effects::this_cpu())
@@ -68,8 +69,9 @@ impl Built {
             None => String::new(),
         };
         let stages = self.stages.as_ref().map(|s| format!("; {s}")).unwrap_or_default();
+        let space = if D::D == 3 { "in space (3D): " } else { "" };
         format!(
-            "{} (dt = {:.3e} s = t_c/{:.1}, t_c = {:.3e} s at {} m/s; stability limit {:.3e} s{accuracy}){stages}",
+            "{space}{} (dt = {:.3e} s = t_c/{:.1}, t_c = {:.3e} s at {} m/s; stability limit {:.3e} s{accuracy}){stages}",
             parts.join(" -> "),
             ts.dt_s,
             ts.steps_per_contact,
@@ -91,6 +93,18 @@ pub fn build_with(scene: &Scene, threads: usize) -> Result<Built, Error> {
     build_limited(scene, threads, &Limits::machine())
 }
 
+/// Whether a packing's region `[a, b]` is the periodic cell along its axis (`periodic`,
+/// from `min`, of length `period`).
+fn periodic_along([a, b]: [f64; 2], periodic: bool, min: f64, period: f64) -> bool {
+    periodic && a == min && b == min + period
+}
+
+/// A packing's region along `axis` at least a grain wide (two, periodic).
+fn region_wide([a, b]: [f64; 2], axis: &str, periodic: bool, r_max: f64) -> Result<(), Error> {
+    let widest = if periodic { 4.0 * r_max } else { 2.0 * r_max };
+    crate::error::check(b - a >= widest, "grains.pack", axis, format!("[{}, {}]", a.shown(), b.shown()), &format!("a region at least {} m wide ({} the largest radius drawn, {} m)", widest.shown(), if periodic { "four times" } else { "twice" }, r_max.shown()))
+}
+
 /// The number of grains a rough wall of glued grains of `radius` holds over `length`.
 fn glued_count(length: f64, radius: f64) -> f64 {
     (length / (2.0 * radius)).floor().max(1.0)
@@ -98,16 +112,206 @@ fn glued_count(length: f64, radius: f64) -> f64 {
 
 /// Build within `limits`: every size is estimated from the scene and checked against the
 /// memory budget before it is allocated, and the grains, walls and time step are checked
-/// for consistency ([`crate::engine::consistency`]) before the engine is.
+/// for consistency ([`crate::engine::consistency`]) before the engine is. A plane
+/// scene's engine ([`build_in`] builds either).
 pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<Built, Error> {
+    build_in::<Plane>(scene, threads, limits)
+}
+
+/// What the build does differently in the plane and in space: the scene's periodic
+/// cell, a packing's region and its relaxation, the rough walls' glued grains (a row in
+/// the plane, an x-z lattice in space), the depth that turns a wall's force into a
+/// stress, and the contact laws only the plane has (rolling resistance, micro-slip).
+/// Everything else is [`build_in`], written once.
+pub trait Building: Pipeline {
+    /// The `dimension` a scene declares for it.
+    const DIMENSION: Dimension;
+    /// The scene's periodic cell.
+    fn boundary(domain: &crate::scene::Domain) -> Boundary<Self>;
+    /// The z extent a rough wall spans and a flat wall's area has, m (0 in the plane):
+    /// the periodic cell's, the packing region's, or the listed grains'.
+    fn z_length(scene: &Scene) -> f64;
+    /// Where a rough wall's lattice starts along z, m (in space): the periodic cell's
+    /// start, the packing region's, or, for listed grains, centred on their z range (a
+    /// plane scene's grains at z = 0 get their glued grains at z = 0).
+    fn z_start(scene: &Scene, boundary: &Boundary<Self>, p: &Particles<Self>, z_length: f64) -> f64;
+    /// A rough wall's glued grains at height `y`: their centres, spread over `length` in
+    /// x from `x0` (and over `z_length` in z from `z0`).
+    fn lattice(length: f64, x0: f64, z_length: f64, z0: f64, y: f64, radius: f64) -> Vec<Self::Vector<f64>>;
+    /// How many glued grains a rough wall of this radius has (an estimate, before any is made).
+    fn glued(length: f64, z_length: f64, radius: f64) -> f64;
+    /// The grains a flat wall's default mass counts: a row (times a row along z in space)
+    /// of mean grains.
+    fn rows(length: f64, z_length: f64, diameter: f64) -> f64;
+    /// A packing's region is periodic along x (and z) where it is the periodic cell along
+    /// it (the packing then wraps); a narrower region is packed between its ends. Each
+    /// side at least a grain wide (two, periodic: a grain must not meet its own image).
+    fn check_region(spec: &crate::scene::PackSpec, boundary: &Boundary<Self>, r_max: f64) -> Result<(), Error>;
+    /// A packing's relaxed centres for radii `radii` in its region from `y0`, of height
+    /// `h`, and the order to store them in: along a space-filling curve (a packing's
+    /// order is arbitrary: near in space, near in memory).
+    fn pack(spec: &crate::scene::PackSpec, radii: &[f64], boundary: &Boundary<Self>, y0: f64, h: f64, r_max: f64) -> (Vec<Self::Vector<f64>>, Vec<usize>);
+    /// The region's cross-section a packing fills upwards (m in the plane, m^2 in space)
+    /// and the measure of a grain of radius r in it (area, volume).
+    fn cross_section(spec: &crate::scene::PackSpec) -> f64;
+    fn measure(r: f64) -> f64;
+    /// The laws only the plane has: rolling resistance and micro-slip (`None`: not
+    /// asked for). Space refuses them by name (validation refused them first).
+    fn plane_only(parts: Parts<'_, Self>, rolling: RollingSpec, tangential: TangentialSpec, elastic: bool, options: ModelOptions) -> Result<Result<Box<dyn Engine<Self>>, Parts<'_, Self>>, Error>;
+}
+
+impl Building for Plane {
+    const DIMENSION: Dimension = Dimension::Two;
+    fn boundary(domain: &crate::scene::Domain) -> Boundary {
+        match domain.periodic_x {
+            Some([a, b]) => Boundary::periodic_x(a, b - a),
+            None => Boundary::open(),
+        }
+    }
+    fn z_length(_: &Scene) -> f64 {
+        0.0
+    }
+    fn z_start(_: &Scene, _: &Boundary, _: &Particles, _: f64) -> f64 {
+        0.0
+    }
+    fn lattice(length: f64, x0: f64, _: f64, _: f64, y: f64, radius: f64) -> Vec<Vec2> {
+        let count = glued_count(length, radius) as usize;
+        (0..count).map(|k| Vec2::new(x0 + (k as f64 + 0.5) * length / count as f64, y)).collect()
+    }
+    fn glued(length: f64, _: f64, radius: f64) -> f64 {
+        glued_count(length, radius)
+    }
+    fn rows(length: f64, _: f64, diameter: f64) -> f64 {
+        length / diameter
+    }
+    fn cross_section(spec: &crate::scene::PackSpec) -> f64 {
+        spec.x[1] - spec.x[0]
+    }
+    fn measure(r: f64) -> f64 {
+        std::f64::consts::PI * r * r
+    }
+    fn check_region(spec: &crate::scene::PackSpec, boundary: &Boundary, r_max: f64) -> Result<(), Error> {
+        region_wide(spec.x, "x", periodic_along(spec.x, boundary.is_periodic(), boundary.x_min, boundary.period), r_max)
+    }
+    fn pack(spec: &crate::scene::PackSpec, radii: &[f64], boundary: &Boundary, y0: f64, h: f64, r_max: f64) -> (Vec<Vec2>, Vec<usize>) {
+        let periodic = periodic_along(spec.x, boundary.is_periodic(), boundary.x_min, boundary.period);
+        let centres = relaxed_packing(radii, spec.x[0], spec.x[1], y0, y0 + h, periodic, spec.seed);
+        let order = crate::scene::pack::morton_order(&centres, spec.x[0], y0, 2.0 * r_max);
+        (centres, order)
+    }
+    fn plane_only(parts: Parts<'_>, rolling: RollingSpec, tangential: TangentialSpec, elastic: bool, options: ModelOptions) -> Result<Result<Box<dyn Engine>, Parts<'_>>, Error> {
+        let hooke = parts.scene.model.normal.hooke();
+        Ok(Ok(match (hooke, tangential, elastic) {
+            // Rolling resistance, with the restitution damping (0 when every e = 1) and the
+            // total displacement; validation refused the other combinations.
+            (None, _, _) if rolling == RollingSpec::Cdt => parts.assemble(HertzHistoryCdt::new(options, Hertz))?,
+            (None, _, _) if rolling == RollingSpec::Epsd2 => parts.assemble(HertzHistoryEpsd2::new(options, Hertz))?,
+            (Some(h), _, _) if rolling == RollingSpec::Cdt => parts.assemble(HookeHistoryCdt::new(options, h))?,
+            (Some(h), _, _) if rolling == RollingSpec::Epsd2 => parts.assemble(HookeHistoryEpsd2::new(options, h))?,
+            (None, _, _) if let RollingSpec::Sds { stiffness, damping } = rolling => parts.assemble(HertzHistorySds::with_rolling(options, Hertz, Sds { k: stiffness, g: damping }))?,
+            (Some(h), _, _) if let RollingSpec::Sds { stiffness, damping } = rolling => parts.assemble(HookeHistorySds::with_rolling(options, h, Sds { k: stiffness, g: damping }))?,
+            // Micro-slip (Hertz only: validation refused it with the spring).
+            (None, TangentialSpec::MindlinDeresiewicz, false) => parts.assemble(HertzMicroSlip::new(options, Hertz))?,
+            (None, TangentialSpec::MindlinDeresiewicz, true) => parts.assemble(HertzMicroSlipElastic::new(options, Hertz))?,
+            _ => return Ok(Err(parts)),
+        }))
+    }
+}
+
+impl Building for Space {
+    const DIMENSION: Dimension = Dimension::Three;
+    fn boundary(domain: &crate::scene::Domain) -> Boundary<Space> {
+        Boundary::<Space>::periodic(domain.periodic_x.map(|[a, b]| (a, b - a)), domain.periodic_z.map(|[a, b]| (a, b - a)))
+    }
+    fn z_length(scene: &Scene) -> f64 {
+        if let Some([a, b]) = scene.domain.periodic_z {
+            return b - a;
+        }
+        match &scene.grains {
+            Grains::Pack(spec) => spec.z.map_or(0.0, |[a, b]| b - a),
+            Grains::List(list) => extent(list.iter().map(|g| (g.x.z(), g.r))),
+            Grains::File { .. } => 0.0,
+        }
+    }
+    fn z_start(scene: &Scene, boundary: &Boundary<Space>, p: &Particles<Space>, z_length: f64) -> f64 {
+        match &scene.grains {
+            _ if boundary.is_periodic_z() => boundary.z_min,
+            Grains::Pack(spec) => spec.z.map_or(0.0, |z| z[0]),
+            _ => {
+                let free = &p.x[..p.n_free];
+                let (lo, hi) = free.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| (a.min(x.z), b.max(x.z)));
+                0.5 * (lo + hi) - 0.5 * z_length
+            }
+        }
+    }
+    fn lattice(length: f64, x0: f64, z_length: f64, z0: f64, y: f64, radius: f64) -> Vec<Vector3<f64>> {
+        let (nx, nz) = (glued_count(length, radius) as usize, glued_count(z_length, radius) as usize);
+        let mut at = Vec::with_capacity(nx * nz);
+        for m in 0..nz {
+            for k in 0..nx {
+                at.push(Vector3::new(x0 + (k as f64 + 0.5) * length / nx as f64, y, z0 + (m as f64 + 0.5) * z_length / nz as f64));
+            }
+        }
+        at
+    }
+    fn glued(length: f64, z_length: f64, radius: f64) -> f64 {
+        glued_count(length, radius) * glued_count(z_length, radius)
+    }
+    fn rows(length: f64, z_length: f64, diameter: f64) -> f64 {
+        (length / diameter) * (z_length / diameter).max(1.0)
+    }
+    fn cross_section(spec: &crate::scene::PackSpec) -> f64 {
+        let [z0, z1] = spec.z.expect("validated: a 3D packing has a z range");
+        (spec.x[1] - spec.x[0]) * (z1 - z0)
+    }
+    fn measure(r: f64) -> f64 {
+        4.0 / 3.0 * std::f64::consts::PI * r * r * r
+    }
+    fn check_region(spec: &crate::scene::PackSpec, boundary: &Boundary<Space>, r_max: f64) -> Result<(), Error> {
+        let z = spec.z.expect("validated: a 3D packing has a z range");
+        region_wide(spec.x, "x", periodic_along(spec.x, boundary.is_periodic(), boundary.x_min, boundary.period), r_max)?;
+        region_wide(z, "z", periodic_along(z, boundary.is_periodic_z(), boundary.z_min, boundary.z_period), r_max)
+    }
+    fn pack(spec: &crate::scene::PackSpec, radii: &[f64], boundary: &Boundary<Space>, y0: f64, h: f64, r_max: f64) -> (Vec<Vector3<f64>>, Vec<usize>) {
+        let z = spec.z.expect("validated: a 3D packing has a z range");
+        let periodic_x = periodic_along(spec.x, boundary.is_periodic(), boundary.x_min, boundary.period);
+        let periodic_z = periodic_along(z, boundary.is_periodic_z(), boundary.z_min, boundary.z_period);
+        let centres = crate::scene::pack::relaxed_packing_space(radii, spec.x, [y0, y0 + h], z, periodic_x, periodic_z, spec.seed);
+        let order = crate::scene::pack::morton_order_space(&centres, [spec.x[0], y0, z[0]], 2.0 * r_max);
+        (centres, order)
+    }
+    fn plane_only(parts: Parts<'_, Space>, rolling: RollingSpec, tangential: TangentialSpec, _: bool, _: ModelOptions) -> Result<Result<Box<dyn Engine<Space>>, Parts<'_, Space>>, Error> {
+        if !rolling.is_none() {
+            return Err(Error::Invalid { field: "model.rolling".into(), value: serde_json::to_string(&rolling).unwrap_or_default(), allowed: "\"none\" in a 3D scene (rolling resistance is the plane's)".into() });
+        }
+        if tangential == TangentialSpec::MindlinDeresiewicz {
+            return Err(Error::Invalid { field: "model.tangential".into(), value: "\"mindlin_deresiewicz\"".into(), allowed: "another formulation in a 3D scene (micro-slip is the plane's)".into() });
+        }
+        Ok(Err(parts))
+    }
+}
+
+/// Build a plane scene's engine (`D = Plane`) or a 3D scene's (`D = Space`), within
+/// `limits`: written once for both ([`Building`] holds what differs).
+pub fn build_in<D: Building>(scene: &Scene, threads: usize, limits: &Limits) -> Result<Built<D>, Error>
+where
+    D::Vector<f64>: serde::Serialize + serde::de::DeserializeOwned,
+    D::Spin<f64>: serde::Serialize + serde::de::DeserializeOwned,
+{
     crate::kernels::threads::Threads::check_count(threads, 1)?;
     scene.validate()?;
+    if scene.dimension != D::DIMENSION {
+        let (want, other) = (D::DIMENSION.count(), scene.dimension.count());
+        return Err(Error::Invalid { field: "dimension".into(), value: other.to_string(), allowed: format!("{want} for this build (a {other}D scene is built by build_in::<{}>)", if other == 3 { "Space" } else { "Plane" }) });
+    }
+    // The contact forces in space run on one thread so far (`Pipeline for Space`).
+    if D::D == 3 && threads > 1 {
+        return Err(Error::BadOption { option: "--threads".into(), value: threads.to_string(), allowed: "1 for a 3D scene (its contact forces run on one thread so far)".into() });
+    }
     let shape = scene.grain_shape;
     let mats = &scene.materials;
-    let boundary = match scene.domain.periodic_x {
-        Some([a, b]) => Boundary::periodic_x(a, b - a),
-        None => Boundary::open(),
-    };
+    let boundary = D::boundary(&scene.domain);
+    let z_length = D::z_length(scene);
     // How many grains, before any is made: a file is read (within the budget's file
     // size) to count them.
     let file = match &scene.grains {
@@ -120,8 +324,8 @@ pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<B
         Grains::Pack(spec) => (spec.count as u64, "grains.pack.count".to_string(), spec.count.to_string()),
     };
     match (&scene.grains, &file) {
-        (Grains::List(list), _) => consistency::given_coordinates(list.iter().map(|g| (Vec2::from(g.x), g.r)), |k| format!("grains.list[{k}]"))?,
-        (Grains::File { path, .. }, Some((grains, lines))) => consistency::given_coordinates(grains.iter().cloned(), |k| format!("the grain on line {} of {path}", lines[k]))?,
+        (Grains::List(list), _) => consistency::given_coordinates(list.iter().map(|g| (g.x.as_slice(), g.r)), |k| format!("grains.list[{k}]"))?,
+        (Grains::File { path, .. }, Some((grains, lines))) => consistency::given_coordinates(grains.iter().map(|(x, r)| (x.as_slice(), *r)), |k| format!("the grain on line {} of {path}", lines[k]))?,
         _ => {}
     }
     // The x length the rough walls span: the periodic cell, the packing's region, or the
@@ -141,7 +345,7 @@ pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<B
     if let Some(ws) = &scene.walls {
         for (name, spec) in [("bottom", &ws.bottom), ("top", &ws.top)] {
             if let SurfaceSpec::Rough { radius } = spec.surface {
-                let n = glued_count(length, radius);
+                let n = D::glued(length, z_length, radius);
                 wall_grains.0 = wall_grains.0.saturating_add(if n < 1e18 { n as u64 } else { u64::MAX });
                 if n > most {
                     most = n;
@@ -155,8 +359,8 @@ pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<B
     let mut estimate = MemoryEstimate { grains: (count, count_field, count_value), wall_grains, materials: mats.len() as u64, microslip, ..Default::default() };
     limits.check(&estimate)?;
 
-    let mut p = Particles::default();
-    let push = |p: &mut Particles, x: Vec2, v: Vec2, w: f64, r: f64, mat: usize| {
+    let mut p = Particles::<D>::default();
+    let push = |p: &mut Particles<D>, x: D::Vector<f64>, v: D::Vector<f64>, w: D::Spin<f64>, r: f64, mat: usize| {
         let m = shape.mass(r, mats[mat].density);
         p.push(x, v, w, r, m, shape.inertia(r, m), mat as u16);
     };
@@ -165,13 +369,15 @@ pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<B
     match &scene.grains {
         Grains::List(list) => {
             for g in list {
-                push(&mut p, Vec2::from(g.x), Vec2::from(g.v), g.omega, g.r, g.material);
+                push(&mut p, g.x.lift::<D>(), g.v.lift::<D>(), g.omega.lift::<D>(), g.r, g.material);
             }
         }
         Grains::File { material, .. } => {
             let (grains, lines) = file.expect("read above");
             for (x, r) in grains {
-                push(&mut p, x, Vec2::zeros(), 0.0, r, *material);
+                let mut at = D::zero::<f64>();
+                (at[0], at[1]) = (x.x, x.y);
+                push(&mut p, at, D::zero(), D::spin_zero(), r, *material);
             }
             if let GrainNames::File(_, l) = &mut names {
                 *l = lines;
@@ -191,23 +397,18 @@ pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<B
             };
             crate::error::check(mass_ok(lo) && mass_ok(hi), "grains.pack", "radius", format!("[{lo}, {hi}] m"), "radii whose masses are finite and > 0 at this density")?;
             let radii = spec.radius.sample(spec.count, spec.seed);
-            let area: f64 = radii.iter().map(|r| std::f64::consts::PI * r * r).sum();
-            let lx = spec.x[1] - spec.x[0];
+            let area: f64 = radii.iter().map(|&r| D::measure(r)).sum();
+            let lx = D::cross_section(spec);
             let h = area / (spec.packing_fraction * lx);
             let r_max = radii.iter().cloned().fold(0.0, f64::max);
             // Too few grains to fill the x range one grain high at this packing fraction.
             if !(h >= 2.0 * r_max) {
                 let need = (2.0 * r_max * spec.packing_fraction * lx / (area / spec.count as f64)).ceil();
-                let allowed = format!(">= about {} (to fill x = [{}, {}] m at packing_fraction {} at least one grain diameter high)", need.shown(), spec.x[0].shown(), spec.x[1].shown(), spec.packing_fraction);
+                let zs = spec.z.map(|[a, b]| format!(", z = [{}, {}] m", a.shown(), b.shown())).unwrap_or_default();
+                let allowed = format!(">= about {} (to fill x = [{}, {}] m{zs} at packing_fraction {} at least one grain diameter high)", need.shown(), spec.x[0].shown(), spec.x[1].shown(), spec.packing_fraction);
                 return Err(Error::Invalid { field: "grains.pack.count".into(), value: spec.count.to_string(), allowed });
             }
-            // Periodic over the cell when the region is the cell (the packing then wraps);
-            // a narrower region is packed between its ends. The region at least a grain
-            // wide (two, over a periodic cell: a grain must not meet its own image), and its
-            // top within the coordinates' bound.
-            let periodic = boundary.is_periodic() && spec.x[0] == boundary.x_min && spec.x[1] == boundary.x_min + boundary.period;
-            let widest = if periodic { 4.0 * r_max } else { 2.0 * r_max };
-            crate::error::check(lx >= widest, "grains.pack", "x", format!("[{}, {}]", spec.x[0].shown(), spec.x[1].shown()), &format!("a region at least {} m wide ({} the largest radius drawn, {} m)", widest.shown(), if periodic { "four times" } else { "twice" }, r_max.shown()))?;
+            D::check_region(spec, &boundary, r_max)?;
             crate::error::check(coordinate_ok(y0 + h), "grains.pack", "count", spec.count, &format!("a packing whose top (y = {} m, from the count, radii and packing_fraction) lies within {bound:e} m of the origin", (y0 + h).shown()))?;
             // The region must fit under a top wall placed by the scene.
             if let Some(ws) = &scene.walls
@@ -222,10 +423,9 @@ pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<B
                     &format!(">= {} m: the packing fills y = [{y0}, {}] m (its count at its packing_fraction), below the top wall's surface", y0 + h + ws.top.surface.radius(), y0 + h),
                 )?;
             }
-            let centres = relaxed_packing(&radii, spec.x[0], spec.x[1], y0, y0 + h, periodic, spec.seed);
-            // A packing's order is arbitrary: store it along a space-filling curve.
-            for k in crate::scene::pack::morton_order(&centres, spec.x[0], y0, 2.0 * r_max) {
-                push(&mut p, centres[k], Vec2::zeros(), 0.0, radii[k], spec.material);
+            let (centres, order) = D::pack(spec, &radii, &boundary, y0, h, r_max);
+            for k in order {
+                push(&mut p, centres[k], D::zero(), D::spin_zero(), radii[k], spec.material);
             }
             packed = true;
         }
@@ -237,6 +437,7 @@ pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<B
     let n_free = p.n_free;
     let mean_r = p.r.iter().sum::<f64>() / n_free as f64;
     let depth = match &scene.walls {
+        _ if D::D == 3 => z_length,
         Some(w) => w.thickness.unwrap_or(shape.depth(2.0 * mean_r)),
         None => shape.depth(2.0 * mean_r),
     };
@@ -244,42 +445,32 @@ pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<B
     // Walls.
     let mut walls = Vec::new();
     if let Some(ws) = &scene.walls {
-        let top_of_grains = (0..n_free).map(|i| p.x[i].y + p.r[i]).fold(f64::NEG_INFINITY, f64::max);
-        let x0 = if boundary.is_periodic() { boundary.x_min } else { p.x.iter().map(|x| x.x).fold(f64::INFINITY, f64::min) };
+        let top_of_grains = (0..n_free).map(|i| p.x[i][1] + p.r[i]).fold(f64::NEG_INFINITY, f64::max);
+        let x0 = if boundary.is_periodic() { boundary.x_min } else { p.x.iter().map(|x| x[0]).fold(f64::INFINITY, f64::min) };
+        let z0 = D::z_start(scene, &boundary, &p, z_length);
         for (name, spec, side) in [("bottom", &ws.bottom, 1.0), ("top", &ws.top, -1.0)] {
             let rough_r = spec.surface.radius();
             let y = spec.y.unwrap_or(top_of_grains + rough_r);
             let surface = match spec.surface {
                 SurfaceSpec::Flat => Surface::Flat,
                 SurfaceSpec::Rough { radius } => {
-                    let count = glued_count(length, radius) as usize;
                     let start = p.len();
-                    for k in 0..count {
-                        let x = x0 + (k as f64 + 0.5) * length / count as f64;
-                        push(&mut p, Vec2::new(x, y), Vec2::new(spec.velocity_x, spec.velocity_y), 0.0, radius, spec.material);
+                    let mut v = D::zero::<f64>();
+                    (v[0], v[1]) = (spec.velocity_x, spec.velocity_y);
+                    for x in D::lattice(length, x0, z_length, z0, y, radius) {
+                        push(&mut p, x, v, D::spin_zero(), radius, spec.material);
                     }
                     Surface::Rough { grains: start..p.len() }
                 }
             };
             let mass = spec.mass.unwrap_or_else(|| match &surface {
                 Surface::Rough { grains } => grains.clone().map(|k| p.m[k]).sum(),
-                Surface::Flat => (length / (2.0 * mean_r)) * shape.mass(mean_r, mats[spec.material].density),
+                Surface::Flat => D::rows(length, z_length, 2.0 * mean_r) * shape.mass(mean_r, mats[spec.material].density),
             });
             let control = control(&spec.control, length, depth);
-            walls.push(Wall {
-                name,
-                surface,
-                control,
-                side,
-                y,
-                x_shift: 0.0,
-                v: Vec2::new(spec.velocity_x, spec.velocity_y),
-                mass,
-                glued_radius: rough_r,
-                material: spec.material,
-                force: Vec2::zeros(),
-                force_prev: Vec2::zeros(),
-            });
+            let mut v = D::zero::<f64>();
+            (v[0], v[1]) = (spec.velocity_x, spec.velocity_y);
+            walls.push(Wall { name, surface, control, side, y, x_shift: 0.0, v, mass, glued_radius: rough_r, material: spec.material, force: D::zero(), force_prev: D::zero() });
         }
     }
 
@@ -308,7 +499,7 @@ pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<B
     let rule = scene.model.beta_rule();
     let mut refs = vec![RefContact::twin(r, m, i, PairMaterial::mix_with(mat, mat, rule))];
     // Against each flat wall, with the wall's own material.
-    for w in walls.iter().filter(|w: &&Wall| w.is_flat()) {
+    for w in walls.iter().filter(|w: &&Wall<D>| w.is_flat()) {
         refs.push(RefContact::wall(r, m, i, PairMaterial::mix_with(mat, &mats[w.material], rule)));
     }
     let ts = &scene.time_step;
@@ -340,7 +531,7 @@ pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<B
         estimate.inside = (p.len() as u64, samples as u64);
     }
     limits.check(&estimate)?;
-    consistency::motion(&p, &walls, Vec2::from(scene.gravity), &names, dt)?;
+    consistency::motion(&p, &walls, scene.gravity.lift::<D>(), &names, dt)?;
     consistency::load(scene, &p, &walls, length, depth, dt)?;
     consistency::stages(scene, &p, &walls, length, depth, dt)?;
     consistency::stable_for_every_pair(scene, &p, &walls, &time_step, friction)?;
@@ -351,7 +542,7 @@ pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<B
     let r_min = p.r[..n_free].iter().cloned().fold(f64::INFINITY, f64::min);
     let skin = scene.neighbor.skin * 2.0 * r_min;
     let domain = Domain::new(&p, &walls, &boundary, travel(scene, &p, &walls), MAX_STEP_MOVE * r_min);
-    let start_speed = (0..n_free).map(|k| p.v[k].norm()).chain(walls.iter().map(|w| w.v.norm())).fold(0.0, f64::max);
+    let start_speed = (0..n_free).map(|k| D::norm(p.v[k])).chain(walls.iter().map(|w| D::norm(w.v))).fold(0.0, f64::max);
     let context = Context {
         start_overlap,
         characteristic_speed: time_step.characteristic_speed_m_s,
@@ -370,15 +561,12 @@ pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<B
     let tsuji = scene.model.damping == DampingSpec::Tsuji;
     let tsuji_sqrt2 = scene.model.damping == DampingSpec::TsujiSqrt2;
     let rolling = if effects.rolling { scene.model.rolling } else { RollingSpec::None };
-    let engine: Box<dyn Engine> = match (scene.model.normal.hooke(), tangential, all_elastic) {
-        // Rolling resistance, with the restitution damping (0 when every e = 1) and the
-        // total displacement; validation refused the other combinations.
-        (None, _, _) if rolling == RollingSpec::Cdt => parts.assemble(HertzHistoryCdt::new(options, Hertz))?,
-        (None, _, _) if rolling == RollingSpec::Epsd2 => parts.assemble(HertzHistoryEpsd2::new(options, Hertz))?,
-        (Some(h), _, _) if rolling == RollingSpec::Cdt => parts.assemble(HookeHistoryCdt::new(options, h))?,
-        (Some(h), _, _) if rolling == RollingSpec::Epsd2 => parts.assemble(HookeHistoryEpsd2::new(options, h))?,
-        (None, _, _) if let RollingSpec::Sds { stiffness, damping } = rolling => parts.assemble(HertzHistorySds::with_rolling(options, Hertz, Sds { k: stiffness, g: damping }))?,
-        (Some(h), _, _) if let RollingSpec::Sds { stiffness, damping } = rolling => parts.assemble(HookeHistorySds::with_rolling(options, h, Sds { k: stiffness, g: damping }))?,
+    // Rolling resistance and micro-slip: the plane's laws.
+    let parts = match D::plane_only(parts, rolling, tangential, all_elastic, options)? {
+        Ok(engine) => return Ok(Built { engine, time_step, depth, length, effects, stages: scene.describe_stages() }),
+        Err(parts) => parts,
+    };
+    let engine: Box<dyn Engine<D>> = match (scene.model.normal.hooke(), tangential, all_elastic) {
         // DMT cohesion, with the restitution damping (0 when every e = 1); validation
         // refused it with the incremental force, Tsuji's damping and the clamp.
         (None, TangentialSpec::Frictionless, _) if effects.cohesion => parts.assemble(HertzDmtFrictionless::new(options, Hertz))?,
@@ -407,8 +595,6 @@ pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<B
         (None, TangentialSpec::TotalForceCap, true) => parts.assemble(HertzForceCapElastic::new(options, Hertz))?,
         (None, TangentialSpec::TotalForceCapSpringKept, false) => parts.assemble(HertzSpringKept::new(options, Hertz))?,
         (None, TangentialSpec::TotalForceCapSpringKept, true) => parts.assemble(HertzSpringKeptElastic::new(options, Hertz))?,
-        (None, TangentialSpec::MindlinDeresiewicz, false) => parts.assemble(HertzMicroSlip::new(options, Hertz))?,
-        (None, TangentialSpec::MindlinDeresiewicz, true) => parts.assemble(HertzMicroSlipElastic::new(options, Hertz))?,
         (None, TangentialSpec::IncrementalForce, false) => parts.assemble(YadeMindlin::new(options, Hertz))?,
         (None, TangentialSpec::IncrementalForce, true) => parts.assemble(YadeMindlinElastic::new(options, Hertz))?,
         (Some(h), TangentialSpec::Frictionless, false) => parts.assemble(HookeFrictionless::new(options, h))?,
@@ -419,8 +605,8 @@ pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<B
         (Some(h), TangentialSpec::TotalForceCap, true) => parts.assemble(HookeForceCapElastic::new(options, h))?,
         (Some(h), TangentialSpec::TotalForceCapSpringKept, false) => parts.assemble(HookeSpringKept::new(options, h))?,
         (Some(h), TangentialSpec::TotalForceCapSpringKept, true) => parts.assemble(HookeSpringKeptElastic::new(options, h))?,
-        // Validation refuses it (micro-slip spreads over the Hertz radius).
-        (Some(_), TangentialSpec::MindlinDeresiewicz, _) => return Err(Error::Invalid { field: "model.tangential".into(), value: "\"mindlin_deresiewicz\"".into(), allowed: "another formulation with a linear spring".into() }),
+        // Taken above in the plane; refused in space, and with the linear spring.
+        (_, TangentialSpec::MindlinDeresiewicz, _) => return Err(Error::Invalid { field: "model.tangential".into(), value: "\"mindlin_deresiewicz\"".into(), allowed: "another formulation with a linear spring, or in 3D (micro-slip is the plane's)".into() }),
         (Some(h), TangentialSpec::IncrementalForce, false) => parts.assemble(HookeIncremental::new(options, h))?,
         (Some(h), TangentialSpec::IncrementalForce, true) => parts.assemble(HookeIncrementalElastic::new(options, h))?,
     };
@@ -447,40 +633,45 @@ fn extent(grains: impl Iterator<Item = (f64, f64)>) -> f64 {
 /// fastest: the whole kinetic energy the scene starts with in its lightest grain, plus
 /// twice the fastest wall's speed (a grain dragged along and flung), plus gravity's
 /// pull over the run.
-fn travel(scene: &Scene, p: &Particles, walls: &[Wall]) -> f64 {
+fn travel<D: Dim>(scene: &Scene, p: &Particles<D>, walls: &[Wall<D>]) -> f64 {
     let n = p.n_free;
-    let energy: f64 = (0..n).map(|i| 0.5 * p.m[i] * p.v[i].norm_squared() + 0.5 * p.inertia[i] * p.omega[i] * p.omega[i]).sum();
+    let energy: f64 = (0..n).map(|i| 0.5 * p.m[i] * D::norm_squared(p.v[i]) + 0.5 * p.inertia[i] * D::spin_dot(p.omega[i], p.omega[i])).sum();
     let m_min = p.m[..n].iter().cloned().fold(f64::INFINITY, f64::min);
-    let v_walls = walls.iter().map(|w| w.v.norm()).fold(scene.fastest_wall(), f64::max);
+    let v_walls = walls.iter().map(|w| D::norm(w.v)).fold(scene.fastest_wall(), f64::max);
     let t = scene.duration;
     let g = scene.strongest_gravity();
     let speed = (2.0 * energy / m_min).sqrt() + 2.0 * v_walls + g * t;
     4.0 * speed * t
 }
 
-struct Parts<'a> {
-    p: Particles,
-    domain: Domain,
+/// A built scene's grains, walls and settings, before its contact law is chosen.
+pub struct Parts<'a, D: Dim = Plane> {
+    p: Particles<D>,
+    domain: Domain<D>,
     context: Context,
-    boundary: Boundary,
-    walls: Vec<Wall>,
+    boundary: Boundary<D>,
+    walls: Vec<Wall<D>>,
     dt: f64,
     skin: f64,
     scene: &'a Scene,
     threads: crate::kernels::threads::Threads,
 }
 
-impl Parts<'_> {
-    fn assemble<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling>(self, law: ContactModel<N, Dm, T, C, Rr>) -> Result<Box<dyn Engine>, Error> {
+impl<D: Pipeline> Parts<'_, D>
+where
+    D::Vector<f64>: serde::Serialize + serde::de::DeserializeOwned,
+    D::Spin<f64>: serde::Serialize + serde::de::DeserializeOwned,
+{
+    fn assemble<N: Normal, Dm: Damping, T: Tangential<D>, C: Cohesion, Rr: Rolling<D>>(self, law: ContactModel<N, Dm, T, C, Rr, D>) -> Result<Box<dyn Engine<D>>, Error> {
         if self.scene.output.energy { self.assemble_with::<N, Dm, T, C, Rr, true>(law) } else { self.assemble_with::<N, Dm, T, C, Rr, false>(law) }
     }
 
-    fn assemble_with<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling, const E: bool>(self, law: ContactModel<N, Dm, T, C, Rr>) -> Result<Box<dyn Engine>, Error> {
+    fn assemble_with<N: Normal, Dm: Damping, T: Tangential<D>, C: Cohesion, Rr: Rolling<D>, const E: bool>(self, law: ContactModel<N, Dm, T, C, Rr, D>) -> Result<Box<dyn Engine<D>>, Error> {
         let scene = self.scene;
         let rotation = T::FRICTION && scene.model.rotation;
         let has_walls = !self.walls.is_empty();
         let has_flat = self.walls.iter().any(Wall::is_flat);
-        let gravity = Vec2::from(scene.gravity);
+        let gravity = scene.gravity.lift::<D>();
         // A stage that turns gravity on needs its stage from the start.
         let pulled = scene.strongest_gravity() > 0.0;
         let n_free = self.p.n_free;
@@ -519,7 +710,7 @@ impl Parts<'_> {
             contacts: scene.output.contacts,
             threads: self.threads.clone(),
         };
-        let (stages, setup) = pipeline::<N, Dm, T, C, Rr, Plane, E>(&plan);
+        let (stages, setup) = pipeline::<N, Dm, T, C, Rr, D, E>(&plan);
         Ok(Box::new(Simulation::new(world, stages, setup)?))
     }
 }
@@ -632,3 +823,4 @@ fn pair_stage<N: Normal, Dm: Damping, T: Tangential, C: Cohesion, Rr: Rolling, c
     let _ = threads;
     Box::new(PairForces::<E, SPIN>::default())
 }
+

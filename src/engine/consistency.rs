@@ -4,9 +4,9 @@
 //! and the wall can follow, whether an impact can happen at all. Each refusal names the
 //! field (its JSON path), the value and what would be allowed.
 
-use crate::error::{Error, Shown};
+use crate::error::{Error, Shown, shown_joined};
 use crate::physics::boundary::Boundary;
-use crate::physics::dim::Vec2;
+use crate::physics::dim::Dim;
 use crate::physics::material::{Material, PairMaterial};
 use crate::physics::particles::Particles;
 use crate::physics::walls::{Control, Surface, Wall};
@@ -49,7 +49,7 @@ impl GrainNames {
         }
     }
     /// The name of grain `i` (free grains first, then the rough walls' grains).
-    pub fn name(&self, i: usize, p: &Particles, walls: &[Wall]) -> String {
+    pub fn name<D: Dim>(&self, i: usize, p: &Particles<D>, walls: &[Wall<D>]) -> String {
         if i >= p.n_free {
             let wall = walls.iter().find(|w| matches!(&w.surface, Surface::Rough { grains } if grains.contains(&i)));
             return match wall {
@@ -81,12 +81,12 @@ fn refuse(field: impl Into<String>, value: impl std::fmt::Display, allowed: impl
 
 /// Every coordinate within [`crate::scene::limits::MAX_COORDINATE_RADII`] largest radii of the
 /// origin.
-pub fn coordinates(scene: &Scene, p: &Particles, names: &GrainNames, walls: &[Wall]) -> Result<(), Error> {
+pub fn coordinates<D: Dim>(scene: &Scene, p: &Particles<D>, names: &GrainNames, walls: &[Wall<D>]) -> Result<(), Error> {
     let r_max = p.r.iter().cloned().fold(0.0, f64::max);
     let bound = crate::scene::limits::MAX_COORDINATE_RADII * r_max;
     let allowed = || format!("within {bound:e} m of the origin ({:e} largest radii: further out, rounding reaches the overlaps the contact law resolves)", crate::scene::limits::MAX_COORDINATE_RADII);
-    if let Some(i) = (0..p.len()).find(|&i| !(p.x[i].x.abs() <= bound && p.x[i].y.abs() <= bound)) {
-        return Err(refuse(names.name(i, p, walls), format!("at ({}, {}) m", p.x[i].x.shown(), p.x[i].y.shown()), allowed()));
+    if let Some(i) = (0..p.len()).find(|&i| !(0..D::D).all(|k| p.x[i][k].abs() <= bound)) {
+        return Err(refuse(names.name(i, p, walls), format!("at ({}) m", point::<D>(p.x[i])), allowed()));
     }
     if let Some([a, b]) = scene.domain.periodic_x
         && !(a.abs() <= bound && b.abs() <= bound)
@@ -104,13 +104,13 @@ pub fn coordinates(scene: &Scene, p: &Particles, names: &GrainNames, walls: &[Wa
 /// Grains given by the scene (listed, or read from a file), as (centre, radius), within
 /// [`crate::scene::limits::MAX_COORDINATE_RADII`] largest radii of the origin: checked before
 /// anything is sized from where they lie (the rough walls span their extent).
-pub fn given_coordinates(grains: impl Iterator<Item = (Vec2, f64)> + Clone, name: impl Fn(usize) -> String) -> Result<(), Error> {
+pub fn given_coordinates<'a>(grains: impl Iterator<Item = (&'a [f64], f64)> + Clone, name: impl Fn(usize) -> String) -> Result<(), Error> {
     let r_max = grains.clone().map(|g| g.1).fold(0.0, f64::max);
     let bound = crate::scene::limits::MAX_COORDINATE_RADII * r_max;
-    match grains.enumerate().find(|(_, (x, _))| !(x.x.abs() <= bound && x.y.abs() <= bound)) {
+    match grains.enumerate().find(|(_, (x, _))| !x.iter().all(|c| c.abs() <= bound)) {
         Some((k, (x, _))) => Err(refuse(
             name(k),
-            format!("at ({}, {}) m", x.x.shown(), x.y.shown()),
+            format!("at ({}) m", shown_joined(x)),
             format!("within {bound:e} m of the origin ({:e} largest radii: further out, rounding reaches the overlaps the contact law resolves)", crate::scene::limits::MAX_COORDINATE_RADII),
         )),
         None => Ok(()),
@@ -119,7 +119,7 @@ pub fn given_coordinates(grains: impl Iterator<Item = (Vec2, f64)> + Clone, name
 
 /// Masses and moments of inertia finite and positive (a radius or density at the edge of
 /// the floating-point range gives 0 or infinity).
-pub fn masses(p: &Particles, names: &GrainNames, walls: &[Wall], mats: &[Material]) -> Result<(), Error> {
+pub fn masses<D: Dim>(p: &Particles<D>, names: &GrainNames, walls: &[Wall<D>], mats: &[Material]) -> Result<(), Error> {
     match (0..p.len()).find(|&i| !(p.m[i].is_finite() && p.m[i] > 0.0 && p.inertia[i].is_finite() && p.inertia[i] > 0.0)) {
         Some(i) => Err(refuse(
             names.name(i, p, walls),
@@ -132,19 +132,19 @@ pub fn masses(p: &Particles, names: &GrainNames, walls: &[Wall], mats: &[Materia
 
 /// The periodic cell must be at least two grain diameters long: below, a grain could
 /// touch another through two of its images, which the minimum image cannot see.
-pub fn periodic_cell(boundary: &Boundary, p: &Particles) -> Result<(), Error> {
+pub fn periodic_cell<D: Dim>(boundary: &Boundary<D>, p: &Particles<D>) -> Result<(), Error> {
     let r_max = p.r.iter().cloned().fold(0.0, f64::max);
     if boundary.is_periodic() && boundary.period < 4.0 * r_max {
         let (a, b) = (boundary.x_min, boundary.x_min + boundary.period);
         return Err(refuse("domain.periodic_x", format!("[{a}, {b}]"), format!("a cell at least 4 r_max = {} m long (two diameters of the largest grain)", 4.0 * r_max)));
     }
     if boundary.is_periodic()
-        && let Some(i) = (0..p.n_free).find(|&i| !(p.x[i].x >= boundary.x_min && p.x[i].x <= boundary.x_min + boundary.period))
+        && let Some(i) = (0..p.n_free).find(|&i| !(p.x[i][0] >= boundary.x_min && p.x[i][0] <= boundary.x_min + boundary.period))
     {
         return Err(refuse(
             "domain.periodic_x",
             format!("[{}, {}]", boundary.x_min, boundary.x_min + boundary.period),
-            format!("a periodic cell that holds every grain (grain {i} is at x = {} m)", p.x[i].x),
+            format!("a periodic cell that holds every grain (grain {i} is at x = {} m)", p.x[i][0]),
         ));
     }
     Ok(())
@@ -155,14 +155,14 @@ pub fn periodic_cell(boundary: &Boundary, p: &Particles) -> Result<(), Error> {
 /// grains), by more than `bound` of the smaller radius. A packing that keeps more is
 /// refused by its packing fraction, with the fix. Returns the largest overlap there is
 /// (grains i, j and the fraction), for the diagnosis of a run that goes wrong.
-pub fn start_overlaps(p: &Particles, walls: &[Wall], boundary: &Boundary, names: &GrainNames, bound: f64, scene: &Scene) -> Result<Option<(usize, usize, f64)>, Error> {
+pub fn start_overlaps<D: Dim>(p: &Particles<D>, walls: &[Wall<D>], boundary: &Boundary<D>, names: &GrainNames, bound: f64, scene: &Scene) -> Result<Option<(usize, usize, f64)>, Error> {
     for w in walls {
         for i in 0..p.n_free {
-            let gap = w.side * (p.x[i].y - w.y);
+            let gap = w.side * (p.x[i][1] - w.y);
             let side = if w.side > 0.0 { "below" } else { "above" };
             if gap < 0.0 {
                 let what = if w.is_flat() { "plane" } else { "glued grains' centres" };
-                return Err(refuse(format!("walls.{}.y", w.name), w.y.shown(), format!("a wall whose {what} lie {side} every grain's centre ({} is at y = {} m)", names.name(i, p, walls), p.x[i].y.shown())));
+                return Err(refuse(format!("walls.{}.y", w.name), w.y.shown(), format!("a wall whose {what} lie {side} every grain's centre ({} is at y = {} m)", names.name(i, p, walls), p.x[i][1].shown())));
             }
             let ratio = (p.r[i] - gap) / p.r[i];
             if w.is_flat() && ratio > bound {
@@ -193,7 +193,7 @@ pub fn start_overlaps(p: &Particles, walls: &[Wall], boundary: &Boundary, names:
         }
         return Err(refuse(
             names.name(i, p, walls),
-            format!("at ({}, {}) m", p.x[i].x.shown(), p.x[i].y.shown()),
+            format!("at ({}) m", point::<D>(p.x[i])),
             format!("grains that overlap by at most {bound} of the smaller radius at the start ({} overlaps it by {ratio:.3})", names.name(j, p, walls)),
         ));
     }
@@ -208,7 +208,7 @@ struct StepBound {
 }
 
 impl StepBound {
-    fn of(p: &Particles, dt: f64) -> StepBound {
+    fn of<D: Dim>(p: &Particles<D>, dt: f64) -> StepBound {
         let r_min = p.r[..p.n_free].iter().cloned().fold(f64::INFINITY, f64::min);
         StepBound { most: MAX_STEP_MOVE * r_min, dt }
     }
@@ -231,29 +231,36 @@ impl StepBound {
 
     /// A wall at velocity `v`, set at `field` (its x velocity's path; the value names the
     /// y velocity too when the wall has one).
-    fn wall(&self, field: String, v: Vec2) -> Result<(), Error> {
-        let value = if v.y == 0.0 { v.x.shown().to_string() } else { format!("[{}, {}] m/s", v.x.shown(), v.y.shown()) };
-        self.check(field, value, "a wall speed", v.norm() * self.dt)
+    fn wall<D: Dim>(&self, field: String, v: D::Vector<f64>) -> Result<(), Error> {
+        let value = if (1..D::D).all(|k| v[k] == 0.0) { v[0].shown().to_string() } else { format!("[{}] m/s", point::<D>(v)) };
+        self.check(field, value, "a wall speed", D::norm(v) * self.dt)
     }
 
     /// Gravity `g`, set at `field`: what it adds to a grain's move in one step.
-    fn gravity(&self, field: String, g: Vec2) -> Result<(), Error> {
-        self.check(field, format!("[{}, {}] m/s^2", g.x.shown(), g.y.shown()), "a gravity that adds", g.norm() * self.dt * self.dt)
+    fn gravity<D: Dim>(&self, field: String, g: D::Vector<f64>) -> Result<(), Error> {
+        self.check(field, format!("[{}] m/s^2", point::<D>(g)), "a gravity that adds", D::norm(g) * self.dt * self.dt)
     }
 }
 
 /// No grain, grain surface or wall moving more than [`MAX_STEP_MOVE`] of the smallest
 /// radius in one step of `dt`, nor gravity adding that much to a move in one step.
-pub fn motion(p: &Particles, walls: &[Wall], gravity: Vec2, names: &GrainNames, dt: f64) -> Result<(), Error> {
+pub fn motion<D: Dim>(p: &Particles<D>, walls: &[Wall<D>], gravity: D::Vector<f64>, names: &GrainNames, dt: f64) -> Result<(), Error> {
     let bound = StepBound::of(p, dt);
     for i in 0..p.n_free {
-        bound.check(names.field(i, "v"), format!("[{}, {}] m/s", p.v[i].x.shown(), p.v[i].y.shown()), "a speed", p.v[i].norm() * dt)?;
-        bound.check(names.field(i, "omega"), format!("{} rad/s", p.omega[i].shown()), "a spin whose surface moves", p.omega[i].abs() * p.r[i] * dt)?;
+        bound.check(names.field(i, "v"), format!("[{}] m/s", point::<D>(p.v[i])), "a speed", D::norm(p.v[i]) * dt)?;
+        let w = D::spin_components(&p.omega[i]);
+        let spin = if w.len() == 1 { format!("{} rad/s", w[0].shown()) } else { format!("[{}] rad/s", shown_joined(w)) };
+        bound.check(names.field(i, "omega"), spin, "a spin whose surface moves", D::spin_dot(p.omega[i], p.omega[i]).sqrt() * p.r[i] * dt)?;
     }
     for w in walls {
-        bound.wall(format!("walls.{}.velocity_x", w.name), w.v)?;
+        bound.wall::<D>(format!("walls.{}.velocity_x", w.name), w.v)?;
     }
-    bound.gravity("gravity".into(), gravity)
+    bound.gravity::<D>("gravity".into(), gravity)
+}
+
+/// A point's (or a vector's) coordinates as a message shows them: `x, y` or `x, y, z`.
+fn point<D: Dim>(v: D::Vector<f64>) -> String {
+    shown_joined(D::flat(std::slice::from_ref(&v)))
 }
 
 /// DMT cohesion that the contacts can hold: for every pair of materials that can touch
@@ -263,7 +270,7 @@ pub fn motion(p: &Particles, walls: &[Wall], gravity: Vec2, names: &GrainNames, 
 /// (at the reduced mass of a twin pair, the softer for the derived spring) must exceed
 /// the pull-off force. Above, the attraction alone would crush the contacts (and a large
 /// enough w would make the forces infinite).
-pub fn cohesion(scene: &Scene, p: &Particles, walls: &[Wall]) -> Result<(), Error> {
+pub fn cohesion<D: Dim>(scene: &Scene, p: &Particles<D>, walls: &[Wall<D>]) -> Result<(), Error> {
     let mats = &scene.materials;
     if scene.adhesive_material().is_none() || p.n_free == 0 {
         return Ok(());
@@ -300,7 +307,7 @@ pub fn cohesion(scene: &Scene, p: &Particles, walls: &[Wall]) -> Result<(), Erro
 /// glued grain, and against each flat wall, every grain of its own material's mass.
 /// Without `time_step.allow_unstable`, dt above the stiffest pair's limit is refused.
 /// `friction`: a tangential force can arise ([`crate::engine::effects::Effects::friction`]).
-pub fn stable_for_every_pair(scene: &Scene, p: &Particles, walls: &[Wall], info: &crate::engine::timestep::TimeStepInfo, friction: bool) -> Result<(), Error> {
+pub fn stable_for_every_pair<D: Dim>(scene: &Scene, p: &Particles<D>, walls: &[Wall<D>], info: &crate::engine::timestep::TimeStepInfo, friction: bool) -> Result<(), Error> {
     use crate::engine::timestep::RefContact;
     if scene.time_step.allow_unstable {
         return Ok(());
@@ -380,7 +387,7 @@ pub fn drag(scene: &Scene, dt: f64) -> Result<(), Error> {
 /// A loaded wall's load must be one the grains can carry (the overlap it presses into
 /// the contacts, from Hertz) and one the wall can follow at this time step (the wall on
 /// its contacts, a mass on springs, within the velocity-Verlet stability limit).
-pub fn load(scene: &Scene, p: &Particles, walls: &[Wall], length: f64, depth: f64, dt: f64) -> Result<(), Error> {
+pub fn load<D: Dim>(scene: &Scene, p: &Particles<D>, walls: &[Wall<D>], length: f64, depth: f64, dt: f64) -> Result<(), Error> {
     let Some(ws) = &scene.walls else { return Ok(()) };
     let ControlSpec::Pressure(pressure) = ws.top.control else { return Ok(()) };
     let Some(wall) = walls.iter().find(|w| matches!(w.control, Control::Load { .. })) else { return Ok(()) };
@@ -389,20 +396,22 @@ pub fn load(scene: &Scene, p: &Particles, walls: &[Wall], length: f64, depth: f6
 
 /// Each stage of a protocol as [`motion`] and [`load`] check the scene's start: the walls'
 /// speeds, gravity, and each load a stage puts on the top wall.
-pub fn stages(scene: &Scene, p: &Particles, walls: &[Wall], length: f64, depth: f64, dt: f64) -> Result<(), Error> {
+pub fn stages<D: Dim>(scene: &Scene, p: &Particles<D>, walls: &[Wall<D>], length: f64, depth: f64, dt: f64) -> Result<(), Error> {
     let bound = StepBound::of(p, dt);
     let velocities = scene.wall_velocities();
     for (k, st) in scene.stages.iter().enumerate() {
         for (w, wall) in walls.iter().enumerate() {
             let at = format!("stages[{k}].walls.{}", wall.name);
-            bound.wall(format!("{at}.velocity_x"), Vec2::from(velocities[k + 1][w]))?;
+            let mut v = D::zero::<f64>();
+            (v[0], v[1]) = (velocities[k + 1][w][0], velocities[k + 1][w][1]);
+            bound.wall::<D>(format!("{at}.velocity_x"), v)?;
             let change = if w == 0 { &st.walls.bottom } else { &st.walls.top };
             if let Some(ControlSpec::Pressure(pa)) = change.control {
                 load_on(scene, p, walls, wall, pa, &at, length, depth, dt)?;
             }
         }
         if let Some(g) = st.gravity {
-            bound.gravity(format!("stages[{k}].gravity"), Vec2::from(g))?;
+            bound.gravity::<D>(format!("stages[{k}].gravity"), g.lift::<D>())?;
         }
     }
     Ok(())
@@ -410,7 +419,7 @@ pub fn stages(scene: &Scene, p: &Particles, walls: &[Wall], length: f64, depth: 
 
 /// [`load`] for a pressure (Pa) on `wall`, set at `at` (a JSON path).
 #[allow(clippy::too_many_arguments)]
-fn load_on(scene: &Scene, p: &Particles, walls: &[Wall], wall: &Wall, pressure: f64, at: &str, length: f64, depth: f64, dt: f64) -> Result<(), Error> {
+fn load_on<D: Dim>(scene: &Scene, p: &Particles<D>, walls: &[Wall<D>], wall: &Wall<D>, pressure: f64, at: &str, length: f64, depth: f64, dt: f64) -> Result<(), Error> {
     let n_free = p.n_free;
     let r_mean = p.r[..n_free].iter().sum::<f64>() / n_free as f64;
     // The softest pair of materials the grains and walls use.
@@ -421,12 +430,15 @@ fn load_on(scene: &Scene, p: &Particles, walls: &[Wall], wall: &Wall, pressure: 
     let soft = used.iter().flat_map(|&a| used.iter().map(move |&b| PairMaterial::mix(&mats[a], &mats[b]))).min_by(|x, y| x.e_star.total_cmp(&y.e_star));
     let Some(soft) = soft else { return Ok(()) };
     let e_star = soft.e_star;
-    // One contact per grain diameter along the wall, each carrying the load on a
-    // diameter of the wall's area: F = p (2 r) t, between two mean grains (R* = r/2,
-    // m* = m/2). Hertz: F = 4/3 E* sqrt(R*) dn^1.5; the linear spring: F = kn dn.
+    // One contact per grain diameter along the wall (in space per grain diameter
+    // squared of its area), each carrying the load on a diameter of the wall's area:
+    // F = p (2 r) t (in space p (2 r)^2), between two mean grains (R* = r/2, m* = m/2).
+    // Hertz: F = 4/3 E* sqrt(R*) dn^1.5; the linear spring: F = kn dn.
     let r_star = 0.5 * r_mean;
     let m_star = 0.5 * p.m[..n_free].iter().sum::<f64>() / n_free as f64;
-    let force = pressure * 2.0 * r_mean * depth;
+    // The wall's area each contact carries, m^2.
+    let share = if D::D == 2 { 2.0 * r_mean * depth } else { 4.0 * r_mean * r_mean };
+    let force = if D::D == 2 { pressure * 2.0 * r_mean * depth } else { pressure * share };
     let law = scene.model.normal;
     let spring = law.hooke().map(|_| law.stiffness(&soft, r_star, m_star, 0.0).kn);
     let dn = match spring {
@@ -436,8 +448,8 @@ fn load_on(scene: &Scene, p: &Particles, walls: &[Wall], wall: &Wall, pressure: 
     let most = MAX_LOAD_OVERLAP * r_mean;
     if !(dn <= most) {
         let (p_max, what) = match spring {
-            None => (4.0 / 3.0 * e_star * r_star.sqrt() * most.powf(1.5) / (2.0 * r_mean * depth), format!("E* = {e_star:.3e} Pa")),
-            Some(kn) => (kn * most / (2.0 * r_mean * depth), format!("kn = {kn:.3e} N/m")),
+            None => (4.0 / 3.0 * e_star * r_star.sqrt() * most.powf(1.5) / share, format!("E* = {e_star:.3e} Pa")),
+            Some(kn) => (kn * most / share, format!("kn = {kn:.3e} N/m")),
         };
         return Err(refuse(
             format!("{at}.control.pressure"),
@@ -451,7 +463,7 @@ fn load_on(scene: &Scene, p: &Particles, walls: &[Wall], wall: &Wall, pressure: 
     // The wall on its contacts: stiffness dF/ddn (Hertz 2 E* sqrt(R* dn), the spring kn)
     // each, one per grain diameter; stable while dt <= 2 / omega, omega^2 = n k / M.
     let k = spring.unwrap_or_else(|| 2.0 * e_star * (r_star * dn).sqrt());
-    let contacts = (length / (2.0 * r_mean)).max(1.0);
+    let contacts = if D::D == 2 { (length / (2.0 * r_mean)).max(1.0) } else { (length / (2.0 * r_mean)).max(1.0) * (depth / (2.0 * r_mean)).max(1.0) };
     let omega = (contacts * k / wall.mass).sqrt();
     if !(dt * omega <= 2.0) {
         let m_min = contacts * k * dt * dt / 4.0;
@@ -468,25 +480,25 @@ fn load_on(scene: &Scene, p: &Particles, walls: &[Wall], wall: &Wall, pressure: 
 
 /// An impact analysis needs grain 0 and grain 1, or grain 0 and a flat wall, and the two
 /// must meet within the run (moving straight, or pulled together by gravity).
-pub fn impact(scene: &Scene, p: &Particles, walls: &[Wall], boundary: &Boundary, duration: f64) -> Result<(), Error> {
+pub fn impact<D: Dim>(scene: &Scene, p: &Particles<D>, walls: &[Wall<D>], boundary: &Boundary<D>, duration: f64) -> Result<(), Error> {
     if scene.analysis != Analysis::Impact {
         return Ok(());
     }
     let n = p.n_free;
     let never = |why: String| refuse("analysis", "impact", format!("a scene whose impact can happen: {why}"));
-    let gravity = Vec2::from(scene.gravity);
+    let gravity = scene.gravity.lift::<D>();
     match n {
         2 => {
             // Gravity moves both alike: only their relative motion decides.
             let d = boundary.image(p.x[0] - p.x[1]);
             let u = p.v[0] - p.v[1];
             let reach = p.r[0] + p.r[1];
-            let u2 = u.norm_squared();
-            let t = if u2 > 0.0 { -d.dot(&u) / u2 } else { f64::INFINITY };
+            let u2 = D::norm_squared(u);
+            let t = if u2 > 0.0 { -D::dot(d, u) / u2 } else { f64::INFINITY };
             if !(t > 0.0 && t.is_finite()) {
                 return Err(never("grains 0 and 1 are not approaching each other".into()));
             }
-            let miss = (d + u * t).norm();
+            let miss = D::norm(d + u * t);
             if miss >= reach {
                 return Err(never(format!("grains 0 and 1 pass each other {miss:.3e} m apart, more than the sum of their radii ({reach:.3e} m)")));
             }
@@ -501,8 +513,8 @@ pub fn impact(scene: &Scene, p: &Particles, walls: &[Wall], boundary: &Boundary,
                 return Err(never("one grain needs a flat wall to hit (or give two grains)".into()));
             };
             // Towards the wall: -side along y.
-            let gap = w.side * (p.x[0].y - w.y) - p.r[0];
-            let (speed, pull) = (-w.side * (p.v[0].y - w.v.y), -w.side * gravity.y);
+            let gap = w.side * (p.x[0][1] - w.y) - p.r[0];
+            let (speed, pull) = (-w.side * (p.v[0][1] - w.v[1]), -w.side * gravity[1]);
             // Distance covered towards the wall by time t: speed t + pull t^2 / 2.
             let reach = |t: f64| speed * t + 0.5 * pull * t * t;
             let ever = speed > 0.0 || pull > 0.0;

@@ -52,7 +52,7 @@ pub struct Effects {
 /// Materials in the pairs of bodies that can touch: each free grain's against every free
 /// grain's, and against every other body's (a rough wall's glued grains, a flat wall),
 /// as material indices `(a, b)`.
-pub(crate) fn meeting_pairs(p: &Particles, walls: &[Wall]) -> Vec<(usize, usize)> {
+pub(crate) fn meeting_pairs<D: crate::physics::dim::Dim>(p: &Particles<D>, walls: &[Wall<D>]) -> Vec<(usize, usize)> {
     let mut free: Vec<usize> = p.material[..p.n_free].iter().map(|&m| m as usize).collect();
     free.sort_unstable();
     free.dedup();
@@ -68,6 +68,11 @@ pub(crate) fn meeting_pairs(p: &Particles, walls: &[Wall]) -> Vec<(usize, usize)
     pairs
 }
 
+/// Numbers as the scene has them, `a, b` (or `a, b, c`).
+fn numbers(c: &[f64]) -> String {
+    c.iter().map(|c| c.to_string()).collect::<Vec<_>>().join(", ")
+}
+
 fn pair_name(mats: &[Material], (a, b): (usize, usize)) -> String {
     let name = |m: usize| if mats[m].name.is_empty() { format!("material {m}") } else { mats[m].name.clone() };
     format!("{} on {}", name(a), name(b))
@@ -75,7 +80,7 @@ fn pair_name(mats: &[Material], (a, b): (usize, usize)) -> String {
 
 impl Effects {
     /// The effects of `scene`, built into grains `p` (free and glued) and `walls`.
-    pub fn of(scene: &Scene, p: &Particles, walls: &[Wall]) -> Effects {
+    pub fn of<D: crate::physics::dim::Dim>(scene: &Scene, p: &Particles<D>, walls: &[Wall<D>]) -> Effects {
         let mats = &scene.materials;
         let pairs = meeting_pairs(p, walls);
         let rule = scene.model.beta_rule();
@@ -160,9 +165,9 @@ impl Effects {
         let clamp = scene.model.limit_force;
         push("normal force clamp (Fn >= 0)", clamp, format!("declared: model.limit_force = {clamp}"), Some("force clamp on"));
         let g = scene.gravity;
-        let staged_g: Vec<String> = scene.stages.iter().enumerate().filter_map(|(k, st)| st.gravity.map(|g| format!("stages[{k}].gravity = [{}, {}]", g[0], g[1]))).collect();
+        let staged_g: Vec<String> = scene.stages.iter().enumerate().filter_map(|(k, st)| st.gravity.map(|g| format!("stages[{k}].gravity = [{}]", numbers(g.as_slice())))).collect();
         let g_why = if staged_g.is_empty() { String::new() } else { format!("; {}", staged_g.join(", ")) };
-        push("gravity", scene.strongest_gravity() > 0.0, format!("declared: gravity = [{}, {}]{g_why}", g[0], g[1]), None);
+        push("gravity", scene.strongest_gravity() > 0.0, format!("declared: gravity = [{}]{g_why}", numbers(g.as_slice())), None);
         let gd = scene.model.general_damping;
         push("general damping (per grain)", gd.is_some(), gd.map_or("declared: model.general_damping absent".into(), |c| format!("declared: model.general_damping = {c}")), None);
         let wall_why = match &scene.walls {
@@ -172,6 +177,10 @@ impl Effects {
         push("walls", scene.walls.is_some(), wall_why, Some("walls"));
         let periodic = scene.domain.periodic_x;
         push("periodic x", periodic.is_some(), periodic.map_or("declared: domain.periodic_x absent".into(), |[a, b]| format!("declared: domain.periodic_x = [{a}, {b}]")), None);
+        if !scene.dimension.is_two() {
+            let periodic = scene.domain.periodic_z;
+            push("periodic z", periodic.is_some(), periodic.map_or("declared: domain.periodic_z absent (grains free along z)".into(), |[a, b]| format!("declared: domain.periodic_z = [{a}, {b}]")), None);
+        }
         push("energy ledger", scene.output.energy, format!("declared: output.energy = {}{}", scene.output.energy, if scene.output.energy { " (the default)" } else { "" }), Some("energy balance on"));
         let impact = scene.analysis == Analysis::Impact;
         push("impact observer", impact, format!("declared: analysis = {}", scene.analysis.name()), None);

@@ -114,9 +114,7 @@ impl<L: ContactLaw> Simulation<L> {
             }
         }
         if let Some(g) = c.gravity {
-            let mut lifted = <L::D as Dim>::zero();
-            (lifted[0], lifted[1]) = (g.x, g.y);
-            w.gravity = lifted;
+            w.gravity = g.lift::<L::D>();
         }
     }
 }

@@ -10,7 +10,7 @@ use crate::physics::boundary::Boundary;
 use crate::physics::contact::model::Held;
 use crate::physics::contact::rolling::Rolling;
 use crate::physics::contact::{ContactHistory, ContactLaw, ContactRecord};
-use crate::physics::dim::{Dim, Plane, Vec2};
+use crate::physics::dim::{Dim, Plane};
 use crate::physics::energy::{EnergyLedger, EnergyRow};
 use crate::physics::material::PairTable;
 use crate::physics::particles::Particles;
@@ -241,8 +241,8 @@ fn shown_components(c: &[f64]) -> String {
 pub struct MotionChange {
     /// The bottom and top walls' changes.
     pub walls: [WallMotion; 2],
-    /// Gravity from now on, m/s^2.
-    pub gravity: Option<Vec2>,
+    /// Gravity from now on, m/s^2 (a plane vector lifted into space with z = 0).
+    pub gravity: Option<crate::scene::Coords>,
 }
 
 /// One wall's change; `None` leaves a field as it is.

@@ -40,7 +40,7 @@ pub struct ProfileSample {
 pub const QUANTITIES: [&str; 8] = ["velocity_x_m_s", "velocity_y_m_s", "solid_fraction", "granular_temperature_m2_s2", "sigma_xx_pa", "sigma_xy_pa", "sigma_yx_pa", "sigma_yy_pa"];
 
 /// The free grains' mean diameter, m (0 without free grains).
-pub fn mean_diameter(p: &crate::physics::particles::Particles) -> f64 {
+pub fn mean_diameter<D: crate::physics::dim::Dim>(p: &crate::physics::particles::Particles<D>) -> f64 {
     if p.n_free == 0 { 0.0 } else { 2.0 * p.r[..p.n_free].iter().sum::<f64>() / p.n_free as f64 }
 }
 

@@ -5,6 +5,8 @@
 //! the mean grain diameter for spheres in the plane; `walls.thickness` overrides).
 //! Shear stress tau = (F_bottom,x - F_top,x) / (2 L_x t), normal stress
 //! sigma = (F_top,y - F_bottom,y) / (2 L_x t), both positive in a sheared, compressed cell.
+//! In space t is the cell's length along z, so the stresses are F / (L_x L_z); the walls'
+//! z forces (friction across the shear) are not in the rows yet.
 //! Their ratio is undefined (written as an empty cell, `null` in JSON) while sigma is zero,
 //! e.g. before any grain touches a wall.
 
@@ -13,7 +15,7 @@ use serde::{Deserialize, Serialize};
 use crate::engine::world::View;
 use crate::observe::stats::{BLOCK_TAUS, Blocking, Estimate, estimate};
 use crate::scene::StatisticsSpec;
-use crate::physics::dim::Vec2;
+use crate::physics::dim::{Dim, Vec2};
 
 /// One row of the wall time series (forces averaged over the sample interval).
 #[derive(Clone, Copy, Debug, Default, Serialize, serde::Deserialize)]
@@ -38,16 +40,16 @@ pub struct WallAverager {
 }
 
 impl WallAverager {
-    pub fn accumulate(&mut self, e: &View) {
+    pub fn accumulate<D: Dim>(&mut self, e: &View<D>) {
         let w = e.walls;
         if w.len() == 2 {
-            self.sum[0] += w[0].force;
-            self.sum[1] += w[1].force;
+            self.sum[0] += Vec2::new(w[0].force[0], w[0].force[1]);
+            self.sum[1] += Vec2::new(w[1].force[0], w[1].force[1]);
             self.n += 1;
         }
     }
     /// The row for the interval just finished; restarts the averages.
-    pub fn row(&mut self, e: &View, length: f64, depth: f64) -> Option<WallRow> {
+    pub fn row<D: Dim>(&mut self, e: &View<D>, length: f64, depth: f64) -> Option<WallRow> {
         let w = e.walls;
         if w.len() != 2 || self.n == 0 {
             return None;

@@ -115,6 +115,13 @@ pub trait Dim: Copy + Default + Debug + Send + Sync + 'static {
     fn plane_spins_mut(w: &mut [Self::Spin<f64>]) -> Option<&mut [f64]>;
     /// The number of components of a spin: 1 in the plane, 3 in space.
     const SPIN: usize;
+    /// A spin `w` about z (rad/s): the plane's number, `[0, 0, w]` in space.
+    fn spin_about_z(w: f64) -> Self::Spin<f64>;
+    /// A spin of three components (rad/s): in the plane its z component (a scene's
+    /// validation refuses one with others in 2D).
+    fn spin_of(w: [f64; 3]) -> Self::Spin<f64>;
+    /// A spin's components (one in the plane, three in space), as a scene writes them.
+    fn spin_components(w: &Self::Spin<f64>) -> &[f64];
 }
 
 /// Two dimensions: grains in the xy-plane spinning about z (every engine today).
@@ -254,6 +261,15 @@ impl Dim for Plane {
     fn spin_flat_mut(w: &mut [f64]) -> &mut [f64] {
         w
     }
+    fn spin_about_z(w: f64) -> f64 {
+        w
+    }
+    fn spin_of(w: [f64; 3]) -> f64 {
+        w[2]
+    }
+    fn spin_components(w: &f64) -> &[f64] {
+        std::slice::from_ref(w)
+    }
     #[inline(always)]
     fn turn<R: Real>(f: Vector2<R>, n_prev: Vector2<R>, n: Vector2<R>, _spin_sum: (), _dt: R) -> Vector2<R> {
         // The axis n_prev x n is along z, and f - f x (s z) = f + (-f_y, f_x) s.
@@ -346,6 +362,15 @@ impl Dim for Space {
     #[inline(always)]
     fn spin_flat_mut(w: &mut [Vector3<f64>]) -> &mut [f64] {
         bytemuck::cast_slice_mut(w)
+    }
+    fn spin_about_z(w: f64) -> Vector3<f64> {
+        Vector3::new(0.0, 0.0, w)
+    }
+    fn spin_of(w: [f64; 3]) -> Vector3<f64> {
+        Vector3::from(w)
+    }
+    fn spin_components(w: &Vector3<f64>) -> &[f64] {
+        w.as_slice()
     }
     #[inline(always)]
     fn turn<R: Real>(f: Vector3<R>, n_prev: Vector3<R>, n: Vector3<R>, spin_sum: Vector3<R>, dt: R) -> Vector3<R> {

@@ -12,6 +12,7 @@ pub const BUILTIN: &[(&str, &str)] = &[
     ("oblique", "a glass bead hitting a flat glass wall at 45 degrees and 1 m/s, e = 0.9, mu = 0.5"),
     ("shear", "the seed's experiment: ~1000 polydisperse glass beads, periodic x, rough walls at +-0.5 m/s under 100 kPa"),
     ("protocol", "the shear cell as a study runs it, in four stages: compress to 100 kPa, relax, shear at +-0.5 m/s, shear at +-2 m/s"),
+    ("shear3d", "the shear box in 3D: 2000 polydisperse glass spheres, periodic x and z, rough walls (glued lattices) at +-0.5 m/s under 100 kPa"),
 ];
 
 fn glass(restitution: f64) -> Material {
@@ -39,14 +40,15 @@ pub fn head_on_under(law: NormalLaw, material: Material, r: f64, v: f64, steps_p
         name: "collision".into(),
         description: BUILTIN[0].1.into(),
         grain_shape: Default::default(),
+        dimension: Default::default(),
         materials: vec![material],
         domain: Domain::default(),
         grains: Grains::List(vec![
-            GrainSpec { x: [-r - gap / 2.0, 0.0], v: [v / 2.0, 0.0], omega: 0.0, r, material: 0 },
-            GrainSpec { x: [r + gap / 2.0, 0.0], v: [-v / 2.0, 0.0], omega: 0.0, r, material: 0 },
+            GrainSpec { x: [-r - gap / 2.0, 0.0].into(), v: [v / 2.0, 0.0].into(), omega: 0.0.into(), r, material: 0 },
+            GrainSpec { x: [r + gap / 2.0, 0.0].into(), v: [-v / 2.0, 0.0].into(), omega: 0.0.into(), r, material: 0 },
         ]),
         walls: None,
-        gravity: [0.0, 0.0],
+        gravity: [0.0, 0.0].into(),
         model: ModelSpec { normal: law, ..ModelSpec::default() },
         time_step: TimeStepSpec {
             rule: TimeStepRule::StepsPerContact { steps: steps_per_contact, impact_speed: v },
@@ -74,7 +76,7 @@ pub fn oblique(material: Material, r: f64, v: f64, angle_deg: f64, tangential: T
     let gap = 10.5 * v * a.cos() * dt;
     s.name = "oblique".into();
     s.description = BUILTIN[1].1.into();
-    s.grains = Grains::List(vec![GrainSpec { x: [0.0, r + gap], v: [v * a.sin(), -v * a.cos()], omega: 0.0, r, material: 0 }]);
+    s.grains = Grains::List(vec![GrainSpec { x: [0.0, r + gap].into(), v: [v * a.sin(), -v * a.cos()].into(), omega: 0.0.into(), r, material: 0 }]);
     s.walls = Some(WallsSpec {
         bottom: WallSpec { y: Some(0.0), velocity_x: 0.0, velocity_y: 0.0, surface: SurfaceSpec::Flat, control: ControlSpec::Fixed, mass: None, material: 0 },
         top: WallSpec { y: Some(1.0), velocity_x: 0.0, velocity_y: 0.0, surface: SurfaceSpec::Flat, control: ControlSpec::Fixed, mass: None, material: 0 },
@@ -104,7 +106,7 @@ pub fn on_rigid_plane(grain: Material, shape: crate::physics::dim::GrainShape, r
     s.description = format!("a grain of radius {r} m on a rigid plane at vn = {vn} m/s, vt = {vt} m/s, spin {omega} rad/s");
     s.materials = vec![grain, rigid];
     s.grain_shape = shape;
-    s.grains = Grains::List(vec![GrainSpec { x: [0.0, r + gap], v: [vt, -vn], omega, r, material: 0 }]);
+    s.grains = Grains::List(vec![GrainSpec { x: [0.0, r + gap].into(), v: [vt, -vn].into(), omega: omega.into(), r, material: 0 }]);
     let w = s.walls.as_mut().expect("oblique has walls");
     w.bottom.material = 1;
     w.top.material = 1;
@@ -127,8 +129,8 @@ pub fn oblique_pair(material: Material, r: f64, v: f64, angle_deg: f64, tangenti
     s.name = "oblique-pair".into();
     s.description = format!("a glass bead hitting a resting one at {angle_deg} degrees and {v} m/s");
     s.grains = Grains::List(vec![
-        GrainSpec { x: [2.0 * r * a.sin(), 2.0 * r * a.cos() + gap], v: [0.0, -v], omega: 0.0, r, material: 0 },
-        GrainSpec { x: [0.0, 0.0], v: [0.0, 0.0], omega: 0.0, r, material: 0 },
+        GrainSpec { x: [2.0 * r * a.sin(), 2.0 * r * a.cos() + gap].into(), v: [0.0, -v].into(), omega: 0.0.into(), r, material: 0 },
+        GrainSpec { x: [0.0, 0.0].into(), v: [0.0, 0.0].into(), omega: 0.0.into(), r, material: 0 },
     ]);
     s.model.tangential = tangential;
     s
@@ -141,14 +143,16 @@ pub fn shear() -> Scene {
         name: "shear".into(),
         description: BUILTIN[2].1.into(),
         grain_shape: Default::default(),
+        dimension: Default::default(),
         materials: vec![glass(0.5)],
-        domain: Domain { periodic_x: Some([0.0, l]) },
+        domain: Domain { periodic_x: Some([0.0, l]), periodic_z: None },
         grains: Grains::Pack(PackSpec {
             count: 1000,
             radius: RadiusDist::Uniform { min: 0.4e-3, max: 0.6e-3 },
             seed: 1,
             material: 0,
             x: [0.0, l],
+            z: None,
             y_min: None,
             packing_fraction: 0.75,
         }),
@@ -157,7 +161,7 @@ pub fn shear() -> Scene {
             top: WallSpec { y: None, velocity_x: v, velocity_y: 0.0, surface: SurfaceSpec::Rough { radius: 0.5e-3 }, control: ControlSpec::Pressure(p), mass: None, material: 0 },
             thickness: None,
         }),
-        gravity: [0.0, 0.0],
+        gravity: [0.0, 0.0].into(),
         model: ModelSpec { lever_arm: LeverArm::Radius, ..ModelSpec::default() },
         time_step: TimeStepSpec { rule: TimeStepRule::StepsPerContact { steps: 50.0, impact_speed: v }, characteristic_speed: None, allow_unstable: false },
         duration: 0.05,
@@ -167,6 +171,25 @@ pub fn shear() -> Scene {
         statistics: Default::default(),
         stages: Vec::new(),
     }
+}
+
+/// The shear box in space: 2000 glass spheres (radii uniform in 0.4-0.6 mm, volume
+/// fraction 0.5 before the load) in a cell periodic in x and z, 10 x 10 mm, between
+/// rough walls (square lattices of glued 0.5 mm spheres) at -+0.5 m/s, the top one under
+/// 100 kPa on its 10 x 10 mm area; the 2D cell's model and time step.
+pub fn shear3d() -> Scene {
+    let (l, v, p) = (0.01, 0.5, 1e5);
+    let mut s = shear();
+    s.name = "shear3d".into();
+    s.description = BUILTIN[4].1.into();
+    s.dimension = Dimension::Three;
+    s.domain = Domain { periodic_x: Some([0.0, l]), periodic_z: Some([0.0, l]) };
+    s.grains = Grains::Pack(PackSpec { count: 2000, radius: RadiusDist::Uniform { min: 0.4e-3, max: 0.6e-3 }, seed: 1, material: 0, x: [0.0, l], z: Some([0.0, l]), y_min: None, packing_fraction: 0.5 });
+    let walls = s.walls.as_mut().expect("the shear cell has walls");
+    (walls.bottom.velocity_x, walls.top.velocity_x, walls.top.control) = (-v, v, ControlSpec::Pressure(p));
+    s.duration = 0.02;
+    s.output.samples = 200;
+    s
 }
 
 /// The shear cell in a four-stage protocol: the packing is compressed under 100 kPa with
@@ -249,6 +272,7 @@ pub fn builtin(name: &str) -> Option<Scene> {
         "oblique" => Some(oblique(glass(0.9), 1e-3, 1.0, 45.0, TangentialSpec::TotalDisplacement, 200.0)),
         "shear" => Some(shear()),
         "protocol" => Some(protocol()),
+        "shear3d" => Some(shear3d()),
         _ => None,
     }
 }

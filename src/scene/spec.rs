@@ -12,6 +12,7 @@ use crate::physics::contact::LeverArm;
 pub use crate::physics::contact::normal::NormalLaw;
 use crate::physics::dim::GrainShape;
 use crate::physics::material::Material;
+pub use crate::scene::coords::{Coords, Dimension, SpinSpec};
 use crate::scene::pack::RadiusDist;
 
 #[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
@@ -24,6 +25,11 @@ pub struct Scene {
     /// Sphere-in-plane (default) or disk of a stated thickness.
     #[serde(default)]
     pub grain_shape: GrainShape,
+    /// 2 (the plane, the default) or 3 (spheres in space). In a 3D scene a vector may
+    /// have three numbers, a spin three components; a plane value is lifted into space
+    /// (z = 0). Left out of written scenes at 2.
+    #[serde(default, skip_serializing_if = "Dimension::is_two")]
+    pub dimension: Dimension,
     /// Materials; grains and walls refer to them by index. Default: one glass.
     #[serde(default = "default_materials")]
     pub materials: Vec<Material>,
@@ -34,9 +40,10 @@ pub struct Scene {
     /// Bottom and top walls. Default: none.
     #[serde(default)]
     pub walls: Option<WallsSpec>,
-    /// Gravity, m/s^2. Default [0, 0] (off: no stage).
+    /// Gravity, m/s^2: `[gx, gy]`, or `[gx, gy, gz]` in 3D. Default [0, 0] (off: no
+    /// stage).
     #[serde(default)]
-    pub gravity: [f64; 2],
+    pub gravity: Coords,
     #[serde(default)]
     pub model: ModelSpec,
     pub time_step: TimeStepSpec,
@@ -76,9 +83,9 @@ pub struct StageSpec {
     /// The walls' motion and control from the stage's start. Default: unchanged.
     #[serde(default)]
     pub walls: StageWalls,
-    /// Gravity from the stage's start, m/s^2. Default: unchanged.
+    /// Gravity from the stage's start, m/s^2 (three numbers in 3D). Default: unchanged.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub gravity: Option<[f64; 2]>,
+    pub gravity: Option<Coords>,
     /// Rows of the time series over the stage (>= 1). Default: the scene's
     /// `output.samples` shared out by duration.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -143,6 +150,10 @@ pub struct Domain {
     /// `[x_min, x_max]` of the periodic cell, m. Default: not periodic.
     #[serde(default)]
     pub periodic_x: Option<[f64; 2]>,
+    /// `[z_min, z_max]` of the periodic cell along z, m (3D only). Default: not periodic
+    /// (grains free along z).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub periodic_z: Option<[f64; 2]>,
 }
 
 /// Where the grains come from.
@@ -197,14 +208,14 @@ impl GrainColumns {
 #[derive(Clone, Debug, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct GrainSpec {
-    /// Centre, m.
-    pub x: [f64; 2],
-    /// Velocity, m/s. Default [0, 0].
+    /// Centre, m: `[x, y]`, or `[x, y, z]` in 3D.
+    pub x: Coords,
+    /// Velocity, m/s (three numbers in 3D). Default [0, 0].
     #[serde(default)]
-    pub v: [f64; 2],
-    /// Spin about z, rad/s. Default 0.
+    pub v: Coords,
+    /// Spin, rad/s: a number (about z), or `[wx, wy, wz]` in 3D. Default 0.
     #[serde(default)]
-    pub omega: f64,
+    pub omega: SpinSpec,
     /// Radius, m.
     pub r: f64,
     /// Material index. Default 0.
@@ -226,11 +237,17 @@ pub struct PackSpec {
     pub material: usize,
     /// `[x_min, x_max]` of the packing region, m (the periodic cell if periodic).
     pub x: [f64; 2],
+    /// `[z_min, z_max]` of the packing region in 3D, m (the periodic cell along z if
+    /// periodic in z; needed in 3D, refused in 2D).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub z: Option<[f64; 2]>,
     /// Lower edge of the packing region, m. Default: on the bottom wall.
     #[serde(default)]
     pub y_min: Option<f64>,
-    /// Area fraction the region is sized for (its height follows), in (0, 0.8].
-    /// Default 0.75 (denser random packings do not relax free of overlaps).
+    /// Area fraction (2D) the region is sized for (its height follows), in (0, 0.8].
+    /// Default 0.75 (denser random packings do not relax free of overlaps). In 3D the
+    /// volume fraction, in (0, 0.6] (random close packing of spheres is about 0.64), to
+    /// be given: the default is the plane's.
     #[serde(default = "default_fraction")]
     pub packing_fraction: f64,
 }
@@ -248,7 +265,8 @@ pub struct WallsSpec {
     pub bottom: WallSpec,
     pub top: WallSpec,
     /// Out-of-plane depth that turns wall forces into stresses, m: stress = F / (L_x t).
-    /// Default: the disk thickness, or the mean grain diameter for spheres in the plane.
+    /// Default: the disk thickness, or the mean grain diameter for spheres in the plane;
+    /// in 3D the cell's length along z (refused there: the wall's area is L_x L_z).
     #[serde(default)]
     pub thickness: Option<f64>,
 }

@@ -37,6 +37,79 @@ impl Scene {
         Ok(s)
     }
 
+    /// What the scene's dimension allows: in 2D no third component anywhere; in 3D
+    /// spheres, and what space does not have yet refused by name (each says so).
+    fn validate_dimension(&self) -> Result<(), Error> {
+        let vectors = || {
+            let mut v: Vec<(String, String, usize)> = Vec::new();
+            if let Grains::List(list) = &self.grains {
+                for (k, g) in list.iter().enumerate() {
+                    v.push((format!("grains.list[{k}]"), "x".into(), g.x.len()));
+                    v.push((format!("grains.list[{k}]"), "v".into(), g.v.len()));
+                    v.push((format!("grains.list[{k}]"), "omega".into(), if g.omega.is_vector() { 3 } else { 2 }));
+                }
+            }
+            v.push((String::new(), "gravity".into(), self.gravity.len()));
+            for (k, st) in self.stages.iter().enumerate() {
+                if let Some(g) = st.gravity {
+                    v.push((format!("stages[{k}]"), "gravity".into(), g.len()));
+                }
+            }
+            v
+        };
+        let not_yet = |at: &str, field: &str, value: &dyn std::fmt::Display, allowed: &str| check(false, at, field, value.to_string(), &format!("{allowed} in a 3D scene (\"dimension\": 3): space does not have it yet"));
+        match self.dimension {
+            Dimension::Two => {
+                for (at, field, n) in vectors() {
+                    let what = if field == "omega" { "a number (the spin about z) in a 2D scene: three components need \"dimension\": 3" } else { "2 numbers [x, y] in a 2D scene: three need \"dimension\": 3" };
+                    check(n <= 2, &at, &field, "3 numbers", what)?;
+                }
+                if let Some([a, b]) = self.domain.periodic_z {
+                    check(false, "domain", "periodic_z", format!("[{a}, {b}]"), "absent in a 2D scene: a periodic z needs \"dimension\": 3")?;
+                }
+                if let Grains::Pack(PackSpec { z: Some([a, b]), .. }) = &self.grains {
+                    check(false, "grains.pack", "z", format!("[{a}, {b}]"), "absent in a 2D scene: a z range needs \"dimension\": 3")?;
+                }
+            }
+            Dimension::Three => {
+                if let GrainShape::Disk { thickness } = self.grain_shape {
+                    check(false, "grain_shape", "disk", format!("{{\"thickness\": {thickness}}}"), "spheres (the default grain_shape) in a 3D scene: a disk is a plane grain")?;
+                }
+                if let Some([a, b]) = self.domain.periodic_z {
+                    check(a.is_finite() && b.is_finite() && finite_pos(b - a), "domain", "periodic_z", format!("[{a}, {b}]"), "finite z_min < z_max")?;
+                }
+                match &self.grains {
+                    Grains::File { path, .. } => not_yet("grains.file", "path", &path, "grains.list or grains.pack")?,
+                    Grains::Pack(p) => {
+                        let Some([a, b]) = p.z else { return check(false, "grains.pack", "z", "none", "[z_min, z_max] of the packing region in a 3D scene, m") };
+                        check(a.is_finite() && b.is_finite() && finite_pos(b - a), "grains.pack", "z", format!("[{a}, {b}]"), "finite z_min < z_max")?;
+                        if let Some([za, zb]) = self.domain.periodic_z {
+                            check(a >= za && b <= zb, "grains.pack", "z", format!("[{a}, {b}]"), &format!("inside the periodic cell [{za}, {zb}] m along z"))?;
+                        }
+                        check(p.packing_fraction <= 0.6, "grains.pack", "packing_fraction", p.packing_fraction, "a volume fraction in (0, 0.6] in a 3D scene (random close packing of spheres is about 0.64; the default 0.75 is the plane's area fraction: give one, 0.5 relaxes quickly)")?;
+                    }
+                    Grains::List(_) => {}
+                }
+                if !self.model.rolling.is_none() {
+                    not_yet("model", "rolling", &serde_json::to_string(&self.model.rolling).unwrap_or_default(), "\"none\" (rolling resistance is the plane's)")?;
+                }
+                if self.model.tangential == TangentialSpec::MindlinDeresiewicz {
+                    not_yet("model", "tangential", &"\"mindlin_deresiewicz\"", "another formulation (micro-slip is the plane's)")?;
+                }
+                if self.output.contacts {
+                    not_yet("output", "contacts", &true, "false (the contact record and the packing observers are the plane's)")?;
+                }
+                if self.analysis == Analysis::Impact {
+                    not_yet("", "analysis", &"\"impact\"", "\"none\" or \"shear\" (the impact observer is the plane's)")?;
+                }
+                if let Some(t) = self.walls.as_ref().and_then(|w| w.thickness) {
+                    check(false, "walls", "thickness", t, "absent in a 3D scene: the walls' area is the cell's x length times its z length")?;
+                }
+            }
+        }
+        Ok(())
+    }
+
     pub fn to_json(&self) -> String {
         serde_json::to_string_pretty(self).expect("a scene always serialises")
     }
@@ -60,6 +133,7 @@ impl Scene {
         if let Some([a, b]) = self.domain.periodic_x {
             check(a.is_finite() && b.is_finite() && finite_pos(b - a), "domain", "periodic_x", format!("[{a}, {b}]"), "finite x_min < x_max")?;
         }
+        self.validate_dimension()?;
         match &self.grains {
             Grains::List(list) => {
                 check(!list.is_empty(), "grains", "list", "[]", "at least one grain")?;
@@ -68,7 +142,7 @@ impl Scene {
                     check(finite_pos(g.r), &at, "r", g.r, "> 0 m")?;
                     check(g.x.iter().all(|v| v.is_finite()), &at, "x", format!("{:?}", g.x), "finite m")?;
                     check(g.v.iter().all(|v| v.is_finite()), &at, "v", format!("{:?}", g.v), "finite m/s")?;
-                    check(g.omega.is_finite(), &at, "omega", g.omega, "finite rad/s")?;
+                    check(g.omega.iter().all(|w| w.is_finite()), &at, "omega", g.omega.to_string(), "finite rad/s")?;
                     check(mat_ok(g.material), &at, "material", g.material, &mats)?;
                 }
             }

@@ -140,17 +140,29 @@ pub fn build_with(scene: &Scene, threads: usize) -> Result<Built, Error> {
     build_limited(scene, threads, &Limits::machine())
 }
 
-/// [`build`] on `threads` threads within `limits`.
+/// [`build`] on `threads` threads within `limits` (a plane scene; [`build_in`] builds
+/// either).
 pub fn build_limited(scene: &Scene, threads: usize, limits: &Limits) -> Result<Built, Error> {
+    build_in::<crate::physics::dim::Plane>(scene, threads, limits)
+}
+
+/// [`build_limited`] in the plane (`D = Plane`) or in space (`D = Space`). The
+/// calibration's head-on impacts are the plane's: two spheres meeting head on move along
+/// their line of centres, the same impact in either dimension.
+pub fn build_in<D: crate::engine::build::Building>(scene: &Scene, threads: usize, limits: &Limits) -> Result<Built<D>, Error>
+where
+    D::Vector<f64>: serde::Serialize + serde::de::DeserializeOwned,
+    D::Spin<f64>: serde::Serialize + serde::de::DeserializeOwned,
+{
     let TimeStepRule::Accuracy { quantity, tolerance, impact_speed } = scene.time_step.rule else {
-        return crate::engine::build::build_limited(scene, threads, limits);
+        return crate::engine::build::build_in::<D>(scene, threads, limits);
     };
     scene.validate()?;
     let (r, material) = scene.smallest_grain(limits)?;
     let cal = calibrate_under(scene.model.normal, scene.model.damping, &scene.materials[material], r, impact_speed, scene.model.limit_force, quantity, tolerance)?;
     let mut resolved = scene.clone();
     resolved.time_step.rule = TimeStepRule::StepsPerContact { steps: cal.steps_per_contact, impact_speed };
-    let mut built = crate::engine::build::build_limited(&resolved, threads, limits)?;
+    let mut built = crate::engine::build::build_in::<D>(&resolved, threads, limits)?;
     built.time_step.accuracy = Some(AccuracyNote { quantity, tolerance, measured_error: cal.measured_error });
     Ok(built)
 }

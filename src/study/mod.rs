@@ -11,4 +11,4 @@ pub mod protocol;
 pub mod run;
 pub mod sweep;
 
-pub use accuracy::{build, build_limited, build_with};
+pub use accuracy::{build, build_in, build_limited, build_with};

@@ -7,7 +7,6 @@ use crate::engine::build::control;
 use crate::engine::timestep::{schedule, stage_steps, stage_too_short, step_count};
 use crate::engine::world::{MotionChange, WallMotion};
 use crate::error::Error;
-use crate::physics::dim::Vec2;
 use crate::scene::{Scene, WallChange};
 
 /// One stage of a run.
@@ -64,7 +63,7 @@ pub fn phases(scene: &Scene, dt: f64, length: f64, depth: f64) -> Result<Vec<Pha
         let samples = st.samples.unwrap_or_else(|| share(scene.output.samples, start, end).max(1));
         let frames = st.frames.unwrap_or_else(|| share(scene.output.frames, start, end));
         let motion = |c: &WallChange| WallMotion { velocity_x: c.velocity_x, velocity_y: c.velocity_y_set(), control: c.control.as_ref().map(|c| control(c, length, depth)) };
-        let change = MotionChange { walls: [motion(&st.walls.bottom), motion(&st.walls.top)], gravity: st.gravity.map(Vec2::from) };
+        let change = MotionChange { walls: [motion(&st.walls.bottom), motion(&st.walls.top)], gravity: st.gravity };
         out.push(Phase {
             name: scene.stage_name(k),
             first,

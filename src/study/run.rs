@@ -12,6 +12,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::engine::build::Built;
 use crate::engine::simulation::Engine;
+use crate::engine::world::View;
+use crate::physics::dim::{Plane, Space};
 use crate::engine::timestep::step_count;
 use crate::engine::world::MotionChange;
 use crate::study::protocol::{Phase, phases};
@@ -62,7 +64,8 @@ pub struct RunOptions {
 }
 
 
-struct Outputs {
+/// The run's output series and frames in its folder (none without one).
+pub struct Outputs {
     folder: Option<OutFolder>,
     energy: Option<CsvSeries>,
     walls: Option<CsvSeries>,
@@ -74,11 +77,68 @@ struct Outputs {
 
 impl Outputs {
     /// Write a frame, with the contacts the step recorded when `contacts`.
-    fn frame(&mut self, e: &dyn Engine, contacts: bool) -> Result<(), Error> {
+    fn frame<D: Running>(&mut self, e: &dyn Engine<D>, contacts: bool) -> Result<(), Error> {
         match (self.vtk.as_mut(), self.folder.as_mut()) {
-            (Some(v), Some(f)) => v.frame(&e.view(), contacts, f),
+            (Some(v), Some(f)) => D::frame(v, &e.view(), contacts, f),
             _ => Ok(()),
         }
+    }
+}
+
+/// What running a scene does differently in the plane and in space: the ParaView frames
+/// (the plane's carry the contacts), the observers that are the plane's so far (the
+/// impact observer and the packing's inside: a 3D scene's validation refuses them by
+/// name), and the volume the grains' solid fraction is of. The run loop is written once
+/// ([`drive`]).
+pub trait Running: crate::engine::build::Building {
+    fn frame(vtk: &mut VtkSeries, e: &View<'_, Self>, contacts: bool, folder: &mut OutFolder) -> Result<(), Error>;
+    /// The impact observer's start and step (the plane's).
+    fn impact(o: &mut ImpactObserver, e: &View<'_, Self>, start: bool);
+    /// The packing's row and the profiles' sample of the contacts recorded now (the plane's).
+    fn inside(st: &mut LoopState, e: &View<'_, Self>, out: &mut Outputs, stage: &str, length: f64, depth: f64) -> Result<(), Error>;
+    /// The cell's measure between the walls a gap apart, per the grains' measure
+    /// ([`crate::engine::build::Building::measure`]): its area in the plane (length x
+    /// gap), its volume in space (length x depth x gap).
+    fn cell_measure(length: f64, depth: f64, gap: f64) -> f64;
+}
+
+impl Running for Plane {
+    fn frame(vtk: &mut VtkSeries, e: &View<'_>, contacts: bool, folder: &mut OutFolder) -> Result<(), Error> {
+        vtk.frame(e, contacts, folder)
+    }
+    fn impact(o: &mut ImpactObserver, e: &View<'_>, start: bool) {
+        if start { o.start(e) } else { o.observe(e) }
+    }
+    fn inside(st: &mut LoopState, v: &View<'_>, out: &mut Outputs, stage: &str, length: f64, depth: f64) -> Result<(), Error> {
+        if let Some(row) = packing_row(v, length, depth) {
+            if let Some(s) = out.packing.as_mut() {
+                s.row_in(stage, &row)?;
+            }
+            st.packing_rows.push(row);
+        }
+        if let Some(n) = st.profile_layers.or_else(|| layer_count(v)) {
+            st.profile_layers = Some(n);
+            st.profile_rows.extend(profile_sample(v, n, length, depth));
+        }
+        Ok(())
+    }
+    fn cell_measure(length: f64, _: f64, gap: f64) -> f64 {
+        length * gap
+    }
+}
+
+impl Running for Space {
+    fn frame(vtk: &mut VtkSeries, e: &View<'_, Space>, _: bool, folder: &mut OutFolder) -> Result<(), Error> {
+        vtk.frame_of(e, folder)
+    }
+    // A 3D scene's validation refuses `analysis: "impact"` and `output.contacts`: no
+    // observer to feed.
+    fn impact(_: &mut ImpactObserver, _: &View<'_, Space>, _: bool) {}
+    fn inside(_: &mut LoopState, _: &View<'_, Space>, _: &mut Outputs, _: &str, _: f64, _: f64) -> Result<(), Error> {
+        Ok(())
+    }
+    fn cell_measure(length: f64, depth: f64, gap: f64) -> f64 {
+        length * depth * gap
     }
 }
 
@@ -109,22 +169,24 @@ impl RunReport {
     }
 }
 
-/// Build and run a scene.
+/// Build and run a scene, in the plane or in space (its `dimension`).
 pub fn run_scene(scene: &Scene, opts: &RunOptions) -> Result<Summary, Error> {
-    let built = crate::study::accuracy::build_limited(scene, 1, &opts.limits)?;
-    run_built(scene, built, opts)
+    match scene.dimension {
+        crate::scene::Dimension::Two => run_built(scene, crate::study::accuracy::build_limited(scene, 1, &opts.limits)?, opts),
+        crate::scene::Dimension::Three => run_built(scene, crate::study::accuracy::build_in::<Space>(scene, 1, &opts.limits)?, opts),
+    }
 }
 
 /// Run an engine built from `scene`. A run that stops early (unstable, interrupted, or an
 /// output it cannot write) still writes everything it can, `summary.json` says what
 /// happened, and the error is returned; [`run_report`] returns the summary with it.
-pub fn run_built(scene: &Scene, built: Built, opts: &RunOptions) -> Result<Summary, Error> {
+pub fn run_built<D: Running>(scene: &Scene, built: Built<D>, opts: &RunOptions) -> Result<Summary, Error> {
     run_report(scene, built, opts)?.into_result()
 }
 
 /// Run an engine built from `scene` and report how it ended ([`RunReport`]). An error
 /// here means the run did not start (its output folder refused or not writable).
-pub fn run_report(scene: &Scene, built: Built, opts: &RunOptions) -> Result<RunReport, Error> {
+pub fn run_report<D: Running>(scene: &Scene, built: Built<D>, opts: &RunOptions) -> Result<RunReport, Error> {
     drive(scene, built, opts, None)
 }
 
@@ -150,6 +212,20 @@ pub fn resume(dir: &Path, threads: Option<usize>, opts: &RunOptions) -> Result<R
         ));
     }
     let scene = Scene::from_json(&c.scene)?;
+    match scene.dimension {
+        crate::scene::Dimension::Two => resume_in::<Plane>(dir, scene, c, threads, opts),
+        crate::scene::Dimension::Three => resume_in::<Space>(dir, scene, c, threads, opts),
+    }
+}
+
+/// [`resume`] in the checkpoint's dimension.
+fn resume_in<D: Running>(dir: &Path, scene: Scene, c: Checkpoint, threads: Option<usize>, opts: &RunOptions) -> Result<RunReport, Error>
+where
+    D::Vector<f64>: serde::Serialize + serde::de::DeserializeOwned,
+    D::Spin<f64>: serde::Serialize + serde::de::DeserializeOwned,
+{
+    let shown = dir.join(CHECKPOINT).display().to_string();
+    let refuse = |why: String| Err(Error::Checkpoint { file: shown.clone(), why });
     let run_scene = c.duration.map_or_else(|| scene.clone(), |d| scene.truncated(d));
     let theirs = crate::scene::limits::read_bounded(&dir.join(RESOLVED_SCENE), opts.limits.file_bytes(), RESOLVED_SCENE)?;
     if theirs != resolved_json(&run_scene) {
@@ -159,7 +235,7 @@ pub fn resume(dir: &Path, threads: Option<usize>, opts: &RunOptions) -> Result<R
         Ok(s) => s,
         Err(e) => return refuse(format!("its run state does not decode ({e})")),
     };
-    let mut built = crate::study::accuracy::build_limited(&scene, threads.unwrap_or(c.threads), &opts.limits)?;
+    let mut built = crate::study::accuracy::build_in::<D>(&scene, threads.unwrap_or(c.threads), &opts.limits)?;
     if let Err(why) = built.engine.restore(&c.engine) {
         return refuse(why);
     }
@@ -182,7 +258,7 @@ fn resolved_json(scene: &Scene) -> String {
 /// What the run loop carries besides the engine, saved in a checkpoint: the observers'
 /// accumulators, the rows so far, what the outputs hold, and the run's clock.
 #[derive(Default, Serialize, Deserialize)]
-struct LoopState {
+pub struct LoopState {
     walls_avg: WallAverager,
     wall_rows: Vec<WallRow>,
     /// The rows each stage ended at (an index into `wall_rows`), as the stages end.
@@ -216,7 +292,7 @@ struct LoopState {
 impl LoopState {
     /// Record the energy balance now (with the ledger on): its residual, and a row of
     /// energy.csv.
-    fn record_energy(&mut self, e: &dyn Engine, out: &mut Outputs, stage: &str, energy_on: bool) -> Result<(), Error> {
+    fn record_energy<D: Running>(&mut self, e: &dyn Engine<D>, out: &mut Outputs, stage: &str, energy_on: bool) -> Result<(), Error> {
         if energy_on {
             let row = e.energy_row();
             self.max_res = self.max_res.max(row.residual_j.abs() / row.put_in().max(f64::MIN_POSITIVE));
@@ -232,7 +308,7 @@ impl LoopState {
     /// and with `inside` (the contacts recorded at this step) the packing row and the
     /// profiles' sample.
     #[allow(clippy::too_many_arguments)]
-    fn sample(&mut self, e: &dyn Engine, out: &mut Outputs, stage: &str, energy_on: bool, inside: bool, length: f64, depth: f64) -> Result<(), Error> {
+    fn sample<D: Running>(&mut self, e: &dyn Engine<D>, out: &mut Outputs, stage: &str, energy_on: bool, inside: bool, length: f64, depth: f64) -> Result<(), Error> {
         self.record_energy(e, out, stage, energy_on)?;
         if let Some(row) = self.walls_avg.row(&e.view(), length, depth) {
             if let Some(w) = out.walls.as_mut() {
@@ -241,17 +317,7 @@ impl LoopState {
             self.wall_rows.push(row);
         }
         if inside {
-            let v = e.view();
-            if let Some(row) = packing_row(&v, length, depth) {
-                if let Some(s) = out.packing.as_mut() {
-                    s.row_in(stage, &row)?;
-                }
-                self.packing_rows.push(row);
-            }
-            if let Some(n) = self.profile_layers.or_else(|| layer_count(&v)) {
-                self.profile_layers = Some(n);
-                self.profile_rows.extend(profile_sample(&v, n, length, depth));
-            }
+            D::inside(self, &e.view(), out, stage, length, depth)?;
         }
         Ok(())
     }
@@ -279,7 +345,7 @@ struct Checkpointing<'a> {
 impl Checkpointing<'_> {
     /// Write `checkpoint.bin` for the state after this step: the series flushed and synced
     /// first (the checkpoint holds their lengths), then the checkpoint, synced and renamed.
-    fn write(&self, e: &dyn Engine, out: &mut Outputs, st: &mut LoopState, wall_time_s: f64) -> Result<(), Error> {
+    fn write<D: Running>(&self, e: &dyn Engine<D>, out: &mut Outputs, st: &mut LoopState, wall_time_s: f64) -> Result<(), Error> {
         let Some(folder) = out.folder.as_mut() else { return Ok(()) };
         st.energy_bytes = out.energy.as_mut().map(|s| s.written(true)).transpose()?;
         st.walls_bytes = out.walls.as_mut().map(|s| s.written(true)).transpose()?;
@@ -306,7 +372,7 @@ impl Checkpointing<'_> {
 
 /// The run loop, from the start or (`resumed`: the outputs reopened and the loop's state;
 /// the engine restored) from a checkpoint.
-fn drive(scene: &Scene, mut built: Built, opts: &RunOptions, resumed: Option<(Outputs, LoopState)>) -> Result<RunReport, Error> {
+fn drive<D: Running>(scene: &Scene, mut built: Built<D>, opts: &RunOptions, resumed: Option<(Outputs, LoopState)>) -> Result<RunReport, Error> {
     let duration = opts.duration.unwrap_or(scene.duration);
     let dt = built.time_step.dt_s;
     // The build checked the scene's duration; an override is checked here, and cuts a
@@ -372,7 +438,7 @@ fn drive(scene: &Scene, mut built: Built, opts: &RunOptions, resumed: Option<(Ou
     let mut error: Option<Error> = None;
     if fresh {
         if let Some(o) = st.impact.as_mut() {
-            o.start(&e.view());
+            D::impact(o, &e.view(), true);
         }
         error = st.record_energy(e, &mut outputs, first_stage, energy_on).and_then(|()| outputs.frame(e, false)).err();
     }
@@ -451,7 +517,7 @@ fn drive(scene: &Scene, mut built: Built, opts: &RunOptions, resumed: Option<(Ou
                     error = Some(err);
                     break 'run;
                 }
-                o.observe(&e.view());
+                D::impact(o, &e.view(), false);
             }
             st.walls_avg.accumulate(&e.view());
             // Nothing is written of a state that failed its check: outputs hold only
@@ -531,7 +597,7 @@ fn drive(scene: &Scene, mut built: Built, opts: &RunOptions, resumed: Option<(Ou
     let mut from = 0;
     for (phase, &to) in phases.iter().zip(&st.stage_ends) {
         let rows = &st.wall_rows[from..to];
-        let mut averaged = (scene.analysis == Analysis::Shear && phase.average && rows.len() >= 4).then(|| shear_summary(rows, e.particles(), length, &scene.statistics));
+        let mut averaged = (scene.analysis == Analysis::Shear && phase.average && rows.len() >= 4).then(|| shear_summary(rows, e.particles(), length, depth, &scene.statistics));
         // The end state is the last stage's: its overlaps are that stage's.
         if let Some(a) = averaged.as_mut().filter(|_| to == st.wall_rows.len()) {
             let p = e.particles();
@@ -632,9 +698,9 @@ fn progress_message(name: &str, time: f64, row: Option<&WallRow>) -> String {
 
 /// The shear estimates of a run's wall rows, and the packing fraction at the last row (its
 /// gap: of a state that passed its checks, also when the run stopped after it).
-fn shear_summary(rows: &[WallRow], p: &crate::physics::particles::Particles, length: f64, statistics: &crate::scene::StatisticsSpec) -> ShearSummary {
-    let area: f64 = (0..p.n_free).map(|i| std::f64::consts::PI * p.r[i] * p.r[i]).sum();
+fn shear_summary<D: Running>(rows: &[WallRow], p: &crate::physics::particles::Particles<D>, length: f64, depth: f64, statistics: &crate::scene::StatisticsSpec) -> ShearSummary {
+    let solid: f64 = (0..p.n_free).map(|i| D::measure(p.r[i])).sum();
     let gap = rows.last().map_or(f64::NAN, |r| r.gap_m);
-    stress_estimates(rows, Some(area / (length * gap)).filter(|f| f.is_finite()), statistics)
+    stress_estimates(rows, Some(solid / D::cell_measure(length, depth, gap)).filter(|f| f.is_finite()), statistics)
 }
 

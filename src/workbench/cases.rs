@@ -261,7 +261,7 @@ fn rolling_cases(out: &mut Vec<Case>) {
                 // Two equal grains pick up equal spins from their contact, which roll
                 // nothing: the incoming one spins at 200 rad/s (w r = 0.2 m/s).
                 if let (true, crate::scene::Grains::List(list)) = (target == "pair", &mut s.grains) {
-                    list[0].omega = 200.0;
+                    list[0].omega = 200.0.into();
                 }
                 s.model.rolling = law;
                 s.model.lever_arm = LeverArm::RadiusMinusHalfOverlap;

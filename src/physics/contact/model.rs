@@ -536,41 +536,41 @@ impl<N: Normal, Dm: Damping, T: Tangential<D>, C: Cohesion, Rr: Rolling<D>, D: D
 
 /// The named combinations grainlab compiles. A scene picks one of these; any other
 /// combination is refused with this list.
-pub type HertzFrictionless = ContactModel<Hertz, Viscoelastic, Frictionless>;
-pub type HertzFrictionlessElastic = ContactModel<Hertz, Undamped, Frictionless>;
+pub type HertzFrictionless<D = Plane> = ContactModel<Hertz, Viscoelastic, Frictionless, NoCohesion, NoRolling, D>;
+pub type HertzFrictionlessElastic<D = Plane> = ContactModel<Hertz, Undamped, Frictionless, NoCohesion, NoRolling, D>;
 /// LIGGGHTS `pair_style gran model hertz tangential history`.
-pub type LiggghtsHertzHistory = ContactModel<Hertz, Viscoelastic, TotalDisplacement>;
-pub type LiggghtsHertzHistoryElastic = ContactModel<Hertz, Undamped, TotalDisplacement>;
+pub type LiggghtsHertzHistory<D = Plane> = ContactModel<Hertz, Viscoelastic, TotalDisplacement, NoCohesion, NoRolling, D>;
+pub type LiggghtsHertzHistoryElastic<D = Plane> = ContactModel<Hertz, Undamped, TotalDisplacement, NoCohesion, NoRolling, D>;
 /// YADE `Law2_ScGeom_MindlinPhys_Mindlin` (incremental tangential force).
-pub type YadeMindlin = ContactModel<Hertz, Viscoelastic, IncrementalForce>;
-pub type YadeMindlinElastic = ContactModel<Hertz, Undamped, IncrementalForce>;
+pub type YadeMindlin<D = Plane> = ContactModel<Hertz, Viscoelastic, IncrementalForce, NoCohesion, NoRolling, D>;
+pub type YadeMindlinElastic<D = Plane> = ContactModel<Hertz, Undamped, IncrementalForce, NoCohesion, NoRolling, D>;
 /// The linear spring-dashpot without friction.
-pub type HookeFrictionless = ContactModel<Hooke, LinearRestitution, Frictionless>;
-pub type HookeFrictionlessElastic = ContactModel<Hooke, Undamped, Frictionless>;
+pub type HookeFrictionless<D = Plane> = ContactModel<Hooke, LinearRestitution, Frictionless, NoCohesion, NoRolling, D>;
+pub type HookeFrictionlessElastic<D = Plane> = ContactModel<Hooke, Undamped, Frictionless, NoCohesion, NoRolling, D>;
 /// LIGGGHTS `pair_style gran model hooke tangential history` (and `hooke/stiffness`).
-pub type LiggghtsHookeHistory = ContactModel<Hooke, LinearRestitution, TotalDisplacement>;
-pub type LiggghtsHookeHistoryElastic = ContactModel<Hooke, Undamped, TotalDisplacement>;
+pub type LiggghtsHookeHistory<D = Plane> = ContactModel<Hooke, LinearRestitution, TotalDisplacement, NoCohesion, NoRolling, D>;
+pub type LiggghtsHookeHistoryElastic<D = Plane> = ContactModel<Hooke, Undamped, TotalDisplacement, NoCohesion, NoRolling, D>;
 /// The linear spring with YADE's incremental tangential force (`Law2_ScGeom_FrictPhys_CundallStrack`'s history).
-pub type HookeIncremental = ContactModel<Hooke, LinearRestitution, IncrementalForce>;
-pub type HookeIncrementalElastic = ContactModel<Hooke, Undamped, IncrementalForce>;
+pub type HookeIncremental<D = Plane> = ContactModel<Hooke, LinearRestitution, IncrementalForce, NoCohesion, NoRolling, D>;
+pub type HookeIncrementalElastic<D = Plane> = ContactModel<Hooke, Undamped, IncrementalForce, NoCohesion, NoRolling, D>;
 
 /// LAMMPS `pair granular ... tangential mindlin` (Hertz) and `linear_history` (the
 /// linear spring): the cap on the total tangential force (`model.tangential =
 /// "total_force_cap"`), with the restitution damping, none, or Tsuji's.
-pub type HertzForceCap = ContactModel<Hertz, Viscoelastic, TotalForceCap>;
-pub type HertzForceCapElastic = ContactModel<Hertz, Undamped, TotalForceCap>;
-pub type HertzTsujiForceCap = ContactModel<Hertz, TsujiFit, TotalForceCap>;
-pub type HookeForceCap = ContactModel<Hooke, LinearRestitution, TotalForceCap>;
-pub type HookeForceCapElastic = ContactModel<Hooke, Undamped, TotalForceCap>;
-pub type HookeTsujiForceCap = ContactModel<Hooke, TsujiFit, TotalForceCap>;
+pub type HertzForceCap<D = Plane> = ContactModel<Hertz, Viscoelastic, TotalForceCap, NoCohesion, NoRolling, D>;
+pub type HertzForceCapElastic<D = Plane> = ContactModel<Hertz, Undamped, TotalForceCap, NoCohesion, NoRolling, D>;
+pub type HertzTsujiForceCap<D = Plane> = ContactModel<Hertz, TsujiFit, TotalForceCap, NoCohesion, NoRolling, D>;
+pub type HookeForceCap<D = Plane> = ContactModel<Hooke, LinearRestitution, TotalForceCap, NoCohesion, NoRolling, D>;
+pub type HookeForceCapElastic<D = Plane> = ContactModel<Hooke, Undamped, TotalForceCap, NoCohesion, NoRolling, D>;
+pub type HookeTsujiForceCap<D = Plane> = ContactModel<Hooke, TsujiFit, TotalForceCap, NoCohesion, NoRolling, D>;
 
 /// The cap on the total tangential force with the spring kept (`model.tangential =
 /// "total_force_cap_spring_kept"`, Kratos' rule): gross sliding exact under damped Hertz,
 /// with the restitution damping or none.
-pub type HertzSpringKept = ContactModel<Hertz, Viscoelastic, TotalForceCapSpringKept>;
-pub type HertzSpringKeptElastic = ContactModel<Hertz, Undamped, TotalForceCapSpringKept>;
-pub type HookeSpringKept = ContactModel<Hooke, LinearRestitution, TotalForceCapSpringKept>;
-pub type HookeSpringKeptElastic = ContactModel<Hooke, Undamped, TotalForceCapSpringKept>;
+pub type HertzSpringKept<D = Plane> = ContactModel<Hertz, Viscoelastic, TotalForceCapSpringKept, NoCohesion, NoRolling, D>;
+pub type HertzSpringKeptElastic<D = Plane> = ContactModel<Hertz, Undamped, TotalForceCapSpringKept, NoCohesion, NoRolling, D>;
+pub type HookeSpringKept<D = Plane> = ContactModel<Hooke, LinearRestitution, TotalForceCapSpringKept, NoCohesion, NoRolling, D>;
+pub type HookeSpringKeptElastic<D = Plane> = ContactModel<Hooke, Undamped, TotalForceCapSpringKept, NoCohesion, NoRolling, D>;
 
 /// Mindlin-Deresiewicz micro-slip (`model.tangential = "mindlin_deresiewicz"`), Hertz
 /// only (its bed of springs spans the Hertz radius, `kt = 8 G* a`), with the restitution
@@ -580,26 +580,26 @@ pub type HertzMicroSlipElastic = ContactModel<Hertz, Undamped, MicroSlip>;
 
 /// LAMMPS `pair granular ... damping tsuji` (`model.damping = "tsuji"`), either normal
 /// law, frictionless or with the total-displacement history.
-pub type HertzTsujiFrictionless = ContactModel<Hertz, TsujiFit, Frictionless>;
-pub type HertzTsujiHistory = ContactModel<Hertz, TsujiFit, TotalDisplacement>;
-pub type HookeTsujiFrictionless = ContactModel<Hooke, TsujiFit, Frictionless>;
-pub type HookeTsujiHistory = ContactModel<Hooke, TsujiFit, TotalDisplacement>;
+pub type HertzTsujiFrictionless<D = Plane> = ContactModel<Hertz, TsujiFit, Frictionless, NoCohesion, NoRolling, D>;
+pub type HertzTsujiHistory<D = Plane> = ContactModel<Hertz, TsujiFit, TotalDisplacement, NoCohesion, NoRolling, D>;
+pub type HookeTsujiFrictionless<D = Plane> = ContactModel<Hooke, TsujiFit, Frictionless, NoCohesion, NoRolling, D>;
+pub type HookeTsujiHistory<D = Plane> = ContactModel<Hooke, TsujiFit, TotalDisplacement, NoCohesion, NoRolling, D>;
 /// LAMMPS' current `damping tsuji` (`model.damping = "tsuji_sqrt2"`: the fit times
 /// sqrt(2)), with the same normal laws and tangential formulations.
-pub type HertzTsujiSqrt2Frictionless = ContactModel<Hertz, TsujiFit<true>, Frictionless>;
-pub type HertzTsujiSqrt2History = ContactModel<Hertz, TsujiFit<true>, TotalDisplacement>;
-pub type HertzTsujiSqrt2ForceCap = ContactModel<Hertz, TsujiFit<true>, TotalForceCap>;
-pub type HookeTsujiSqrt2Frictionless = ContactModel<Hooke, TsujiFit<true>, Frictionless>;
-pub type HookeTsujiSqrt2History = ContactModel<Hooke, TsujiFit<true>, TotalDisplacement>;
-pub type HookeTsujiSqrt2ForceCap = ContactModel<Hooke, TsujiFit<true>, TotalForceCap>;
+pub type HertzTsujiSqrt2Frictionless<D = Plane> = ContactModel<Hertz, TsujiFit<true>, Frictionless, NoCohesion, NoRolling, D>;
+pub type HertzTsujiSqrt2History<D = Plane> = ContactModel<Hertz, TsujiFit<true>, TotalDisplacement, NoCohesion, NoRolling, D>;
+pub type HertzTsujiSqrt2ForceCap<D = Plane> = ContactModel<Hertz, TsujiFit<true>, TotalForceCap, NoCohesion, NoRolling, D>;
+pub type HookeTsujiSqrt2Frictionless<D = Plane> = ContactModel<Hooke, TsujiFit<true>, Frictionless, NoCohesion, NoRolling, D>;
+pub type HookeTsujiSqrt2History<D = Plane> = ContactModel<Hooke, TsujiFit<true>, TotalDisplacement, NoCohesion, NoRolling, D>;
+pub type HookeTsujiSqrt2ForceCap<D = Plane> = ContactModel<Hooke, TsujiFit<true>, TotalForceCap, NoCohesion, NoRolling, D>;
 
 /// DMT cohesion (`materials[].work_of_adhesion` > 0) with either normal law and its
 /// restitution damping (which is 0 at e = 1), frictionless or with the total-displacement
 /// history: LAMMPS `pair granular dmt` for Hertz.
-pub type HertzDmtFrictionless = ContactModel<Hertz, Viscoelastic, Frictionless, Dmt>;
-pub type HertzDmtHistory = ContactModel<Hertz, Viscoelastic, TotalDisplacement, Dmt>;
-pub type HookeDmtFrictionless = ContactModel<Hooke, LinearRestitution, Frictionless, Dmt>;
-pub type HookeDmtHistory = ContactModel<Hooke, LinearRestitution, TotalDisplacement, Dmt>;
+pub type HertzDmtFrictionless<D = Plane> = ContactModel<Hertz, Viscoelastic, Frictionless, Dmt, NoRolling, D>;
+pub type HertzDmtHistory<D = Plane> = ContactModel<Hertz, Viscoelastic, TotalDisplacement, Dmt, NoRolling, D>;
+pub type HookeDmtFrictionless<D = Plane> = ContactModel<Hooke, LinearRestitution, Frictionless, Dmt, NoRolling, D>;
+pub type HookeDmtHistory<D = Plane> = ContactModel<Hooke, LinearRestitution, TotalDisplacement, Dmt, NoRolling, D>;
 
 /// Rolling resistance (`model.rolling`) with either normal law, its restitution damping
 /// and the total-displacement history: LIGGGHTS `rolling_friction cdt` and `epsd2`,

@@ -147,6 +147,8 @@ const SPRING_Y: &str = "the KN, KS (and CN, CS) lists of ViscElMat: twice the pa
 const SPRING_L: &str = "`fix m5 kn`, `fix m6 kt` per pair of atom types, and the damping rates gamman, gammat = -2 beta(e) sqrt(k / m*) (LIGGGHTS multiplies them by m*)";
 const SPRING_REFUSED_L: &str = "a pair of materials that meets at more than one reduced mass (grains of two sizes, or a grain and a flat wall): hooke/stiffness takes one damping rate per pair of atom types, times m*";
 const SPIN_NO_ROTATION: &str = "a non-zero spin with model.rotation = false (and friction): grainlab's grain-grain contacts then leave the spin out of the contact velocity, LIGGGHTS and LAMMPS (`nve`) and YADE (blocked rotation) keep the spin, which never changes, in it";
+const SPACE: &str = "3: a 3D scene's decks are not written yet (the exports are the plane's: spheres at z = 0 with z motion blocked); the 3D decks come with the 3D workbench cases";
+const SPACE_ONLY: &str = "absent: scene validation refuses it in a 2D scene, and a 3D scene is refused as a whole (see dimension)";
 const NOT_PHYSICS_OUTPUT: &str = "grainlab's own output";
 
 /// Every leaf of the scene schema and its decision for each code.
@@ -164,6 +166,7 @@ pub const FIELDS: &[Field] = &[
         refused("disks are not exported yet (see grain_shape)"),
         refused("disks cannot be expressed (see grain_shape)"),
     ),
+    both("dimension", refused(SPACE)),
     both("materials[].name", outside("a label: the decks refer to materials by position (LIGGGHTS atom type k + 1, YADE mats[k])")),
     each("materials[].youngs_modulus", written("`fix m1 ... youngsModulus peratomtype`"), written("E[k], FrictMat(young)")).in_lammps(written(MODULI_M)),
     each(
@@ -213,6 +216,7 @@ pub const FIELDS: &[Field] = &[
         written("a periodic cell of length L from x_min (y and z 10x the packing: YADE cells are periodic in every direction)")
             .or_refused("an impact scene, or a scene without two rough walls: YADE's periodic script is the shear cell's (rough rows, the top one loaded or held); or a cell shorter than 4 r_max + 2 r_min: YADE's periodic collider stops on a body whose bounds (its diameter and twice the Verlet distance, by default half the smallest radius) span over half the cell"),
     ),
+    both("domain.periodic_z", one_value(SPACE_ONLY)),
     both("grains.list[].x", written(LIST_X)),
     both("grains.list[].v", written(LIST_V)),
     both("grains.list[].omega", written("grains.data Velocities: wz").or_refused(SPIN_NO_ROTATION)),
@@ -237,6 +241,7 @@ pub const FIELDS: &[Field] = &[
     both("grains.pack.material", written(ATOM_TYPE)),
     both("grains.pack.x", written(PACKED)),
     both("grains.pack.y_min", written(PACKED)),
+    both("grains.pack.z", one_value(SPACE_ONLY)),
     both("grains.pack.packing_fraction", written(PACKED)),
     each("walls.bottom.y", written(Y_L), written(Y_Y)).in_lammps(written(Y_M)),
     each("walls.bottom.velocity_x", written(VX_L), written(VX_Y)),

@@ -21,10 +21,13 @@ pub(crate) struct Exported {
 }
 
 pub(crate) fn prepare(scene: &Scene, code: Code, limits: &crate::scene::limits::Limits) -> Result<Exported, Error> {
+    if !scene.dimension.is_two() {
+        return Err(fields::refuse(code, "dimension", scene.dimension.count(), ""));
+    }
     if let GrainShape::Disk { thickness } = scene.grain_shape {
         return Err(fields::refuse(code, "grain_shape.disk.thickness", thickness, ""));
     }
-    if let [gx, gy] = scene.gravity
+    if let &[gx, gy] = scene.gravity.as_slice()
         && (gx != 0.0 || gy != 0.0)
     {
         return Err(fields::refuse(code, "gravity", format!("[{gx}, {gy}]"), ""));
@@ -59,7 +62,7 @@ pub(crate) fn prepare(scene: &Scene, code: Code, limits: &crate::scene::limits::
     if !scene.model.rotation
         && scene.model.tangential != TangentialSpec::Frictionless
         && let Grains::List(list) = &scene.grains
-        && let Some((k, g)) = list.iter().enumerate().find(|(_, g)| g.omega != 0.0)
+        && let Some((k, g)) = list.iter().enumerate().find(|(_, g)| g.omega.norm() != 0.0)
     {
         return Err(fields::refuse(code, &format!("grains.list[{k}].omega"), g.omega, "model.rotation = false"));
     }
@@ -70,7 +73,7 @@ pub(crate) fn prepare(scene: &Scene, code: Code, limits: &crate::scene::limits::
     if let Some(w) = e.walls().iter().find(|w| w.is_flat() && w.v.y != 0.0) {
         return Err(fields::refuse(code, &format!("walls.{}.velocity_y", w.name), w.v.y, &format!("walls.{}.surface = flat", w.name)));
     }
-    if let Some((k, g)) = scene.stages.iter().enumerate().find_map(|(k, st)| st.gravity.filter(|g| *g != [0.0, 0.0]).map(|g| (k, g))) {
+    if let Some((k, g)) = scene.stages.iter().enumerate().find_map(|(k, st)| st.gravity.filter(|g| g.norm() != 0.0).map(|g| (k, g))) {
         return Err(fields::refuse(code, &format!("stages[{k}].gravity"), format!("[{}, {}]", g[0], g[1]), ""));
     }
     if !scene.stages.is_empty()
