@@ -162,6 +162,31 @@ fn bases(dir: &Path) -> Vec<Value> {
     rolling_pair["materials"][0]["rolling_friction"] = json!(0.2);
     rolling_pair["grains"]["list"][0]["omega"] = json!(300.0);
     out.push(rolling_pair);
+    // 3D: the shear box smaller (150 spheres in a 4 x 4 mm cell periodic in x and z), a
+    // flat-walled box open in z under gravity, and two spheres meeting off centre, one
+    // spinning about a skew axis.
+    let mut box3d = json(&builtin::builtin("shear3d").unwrap());
+    box3d["domain"] = json!({"periodic_x": [0.0, 0.004], "periodic_z": [0.0, 0.004]});
+    box3d["grains"]["pack"]["count"] = json!(150);
+    box3d["grains"]["pack"]["x"] = json!([0.0, 0.004]);
+    box3d["grains"]["pack"]["z"] = json!([0.0, 0.004]);
+    box3d["output"]["frames"] = json!(3);
+    out.push(box3d.clone());
+    let mut open3d = box3d;
+    open3d["domain"] = json!({"periodic_x": [0.0, 0.004]});
+    open3d["walls"]["bottom"]["surface"] = "flat".into();
+    open3d["walls"]["top"]["surface"] = "flat".into();
+    open3d["walls"]["top"]["control"] = "fixed".into();
+    open3d["walls"]["top"]["y"] = json!(0.03);
+    open3d["gravity"] = json!([0.0, -9.81, 1.0]);
+    open3d["model"]["tangential"] = "incremental_force".into();
+    out.push(open3d);
+    out.push(json!({"name": "pair3d", "dimension": 3,
+        "grains": {"list": [{"x": [0.0, 0.0, 0.0], "v": [0.5, 0.3, 0.4], "omega": [10.0, -20.0, 5.0], "r": 0.001},
+                            {"x": [0.0025, 0.0015, 0.002], "v": [-0.5, -0.3, -0.4], "r": 0.001}]},
+        "model": {"tangential": "total_force_cap", "general_damping": 10.0},
+        "time_step": {"rule": {"steps_per_contact": {"steps": 50, "impact_speed": 1.0}}},
+        "duration": 0.004, "output": {"samples": 10, "frames": 2}}));
     out
 }
 
@@ -369,36 +394,10 @@ fn exercise(text: &str, dir: &Path, export: bool, tally: &mut Tally, case: &str)
             return Ok(());
         }
     };
-    let built = match grainlab::build_limited(&scene, 1, &limits) {
-        Ok(b) => b,
-        Err(e) => {
-            tally.refused += 1;
-            if let Error::Invalid { field, value, allowed } = &e {
-                prop_assert!(!field.is_empty() && !value.is_empty() && !allowed.is_empty(), "{e}");
-            }
-            return Ok(());
-        }
-    };
-    let dt = built.time_step.dt_s;
-    prop_assert!(dt.is_finite() && dt > 0.0, "dt = {dt}");
-    let duration = scene.duration.min(STEPS * dt);
-    let out = dir.join("out");
-    let opts = RunOptions { out: Some(out.clone()), overwrite: true, duration: Some(duration), ..Default::default() };
-    let report = run_report(&scene, built, &opts).map_err(|e| TestCaseError::fail(format!("the run did not start: {e}")))?;
-    let s = &report.summary;
-    prop_assert!(s.steps as f64 <= STEPS + 1.0, "{} steps", s.steps);
-    prop_assert!(grainlab::finite::non_finite_column(s).is_none(), "summary: {:?} not finite", grainlab::finite::non_finite_column(s));
-    prop_assert!(report.write_error.is_none(), "{:?}", report.write_error);
-    match &report.ending {
-        None => tally.completed += 1,
-        Some(Error::Unstable { what, advice, .. }) => {
-            prop_assert!(!what.is_empty() && !advice.is_empty());
-            tally.stopped += 1;
-            tally.stops.push(format!("[{case}] {what} -- {advice}"));
-        }
-        Some(e) => return Err(TestCaseError::fail(format!("the run ended with {e}"))),
+    match scene.dimension {
+        grainlab::scene::Dimension::Two => run_case(&scene, grainlab::build_limited(&scene, 1, &limits), dir, tally, case)?,
+        grainlab::scene::Dimension::Three => run_case(&scene, grainlab::build_in::<grainlab::physics::dim::Space>(&scene, 1, &limits), dir, tally, case)?,
     }
-    assert_files_finite(&out);
     if export {
         for code in [grainlab::workbench::export::Code::Liggghts, grainlab::workbench::export::Code::Yade, grainlab::workbench::export::Code::Lammps] {
             match grainlab::workbench::export::export_files(&scene, code, false, &limits) {
@@ -415,6 +414,42 @@ fn exercise(text: &str, dir: &Path, export: bool, tally: &mut Tally, case: &str)
             }
         }
     }
+    Ok(())
+}
+
+/// Run a built case (in the plane or in space) into `dir/out` within the step bound, or
+/// count its refusal.
+fn run_case<D: grainlab::study::run::Running>(scene: &Scene, built: Result<grainlab::Built<D>, Error>, dir: &Path, tally: &mut Tally, case: &str) -> Result<(), TestCaseError> {
+    let built = match built {
+        Ok(b) => b,
+        Err(e) => {
+            tally.refused += 1;
+            if let Error::Invalid { field, value, allowed } = &e {
+                prop_assert!(!field.is_empty() && !value.is_empty() && !allowed.is_empty(), "{e}");
+            }
+            return Ok(());
+        }
+    };
+    let dt = built.time_step.dt_s;
+    prop_assert!(dt.is_finite() && dt > 0.0, "dt = {dt}");
+    let duration = scene.duration.min(STEPS * dt);
+    let out = dir.join("out");
+    let opts = RunOptions { out: Some(out.clone()), overwrite: true, duration: Some(duration), ..Default::default() };
+    let report = run_report(scene, built, &opts).map_err(|e| TestCaseError::fail(format!("the run did not start: {e}")))?;
+    let s = &report.summary;
+    prop_assert!(s.steps as f64 <= STEPS + 1.0, "{} steps", s.steps);
+    prop_assert!(grainlab::finite::non_finite_column(s).is_none(), "summary: {:?} not finite", grainlab::finite::non_finite_column(s));
+    prop_assert!(report.write_error.is_none(), "{:?}", report.write_error);
+    match &report.ending {
+        None => tally.completed += 1,
+        Some(Error::Unstable { what, advice, .. }) => {
+            prop_assert!(!what.is_empty() && !advice.is_empty());
+            tally.stopped += 1;
+            tally.stops.push(format!("[{case}] {what} -- {advice}"));
+        }
+        Some(e) => return Err(TestCaseError::fail(format!("the run ended with {e}"))),
+    }
+    assert_files_finite(&out);
     Ok(())
 }
 
@@ -447,7 +482,10 @@ fn mutated_scenes_are_refused_by_name_or_run_to_a_finite_end_within_budget() {
     // Every base runs as it is.
     let mut tally = Tally::default();
     for (k, b) in bases.iter().enumerate() {
-        let built = Scene::from_json(&b.to_string()).and_then(|s| grainlab::build_limited(&s, 1, &Limits::with_memory(BUDGET)).map(|_| ()));
+        let built = Scene::from_json(&b.to_string()).and_then(|s| match s.dimension {
+            grainlab::scene::Dimension::Two => grainlab::build_limited(&s, 1, &Limits::with_memory(BUDGET)).map(|_| ()),
+            grainlab::scene::Dimension::Three => grainlab::build_in::<grainlab::physics::dim::Space>(&s, 1, &Limits::with_memory(BUDGET)).map(|_| ()),
+        });
         assert!(built.is_ok(), "base {k}: {built:?}");
         exercise(&b.to_string(), dir.path(), true, &mut tally, "base").unwrap();
     }
