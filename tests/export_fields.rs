@@ -295,14 +295,7 @@ fn engine_run(s: &Scene) -> Vec<f64> {
         return engine_run_in_space(s);
     }
     let mut b = grainlab::build(s).unwrap();
-    let (steps, _) = grainlab::engine::timestep::schedule(s.duration, b.time_step.dt_s, s.output.samples);
-    let mut out = vec![b.time_step.dt_s, steps as f64];
-    for _ in 0..60 {
-        if b.engine.step().is_err() {
-            out.push(f64::NAN);
-            break;
-        }
-    }
+    let mut out = stepped(&mut b, s);
     let p = b.engine.particles();
     for i in 0..p.len() {
         out.extend([p.x[i].x, p.x[i].y, p.v[i].x, p.v[i].y, p.omega[i], p.r[i], p.m[i], p.inertia[i], p.material[i] as f64]);
@@ -321,6 +314,17 @@ fn engine_run(s: &Scene) -> Vec<f64> {
 /// spin (three components each) after 60 steps.
 fn engine_run_in_space(s: &Scene) -> Vec<f64> {
     let mut b = grainlab::build_in::<grainlab::physics::dim::Space>(s, 1, &Default::default()).unwrap();
+    let mut out = stepped(&mut b, s);
+    let p = b.engine.particles();
+    for i in 0..p.len() {
+        out.extend(p.x[i].iter().chain(p.v[i].iter()).chain(p.omega[i].iter()).copied());
+        out.extend([p.r[i], p.m[i]]);
+    }
+    out
+}
+
+/// Step a built scene 60 times: dt and the run's steps, then NaN if a step failed.
+fn stepped<D: grainlab::physics::dim::Dim>(b: &mut grainlab::Built<D>, s: &Scene) -> Vec<f64> {
     let (steps, _) = grainlab::engine::timestep::schedule(s.duration, b.time_step.dt_s, s.output.samples);
     let mut out = vec![b.time_step.dt_s, steps as f64];
     for _ in 0..60 {
@@ -328,11 +332,6 @@ fn engine_run_in_space(s: &Scene) -> Vec<f64> {
             out.push(f64::NAN);
             break;
         }
-    }
-    let p = b.engine.particles();
-    for i in 0..p.len() {
-        out.extend(p.x[i].iter().chain(p.v[i].iter()).chain(p.omega[i].iter()).copied());
-        out.extend([p.r[i], p.m[i]]);
     }
     out
 }

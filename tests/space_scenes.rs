@@ -287,3 +287,24 @@ fn a_3d_scene_on_more_threads_is_refused_by_name() {
     let e = grainlab::build_in::<Space>(&scene, 2, &limits()).err().expect("refused").to_string();
     assert!(e.contains("--threads") && e.contains('2'), "{e}");
 }
+
+/// A periodic cell along z must hold its grains and be at least two diameters of the
+/// largest long (a grain must not meet its own image), and hold a rough wall's glued
+/// sphere: refused by name otherwise.
+#[test]
+fn a_periodic_z_too_short_or_missing_grains_is_refused_by_name() {
+    let ts = r#""time_step": {"rule": {"steps_per_contact": {"steps": 50, "impact_speed": 1}}}, "duration": 1e-3"#;
+    let grains = r#""grains": {"list": [{"x": [0, 0, 0.001], "r": 0.001}, {"x": [0.003, 0, 0.001], "v": [-1, 0, 0], "r": 0.001}]}"#;
+    let e = refused(&format!(r#"{{"name": "a", "dimension": 3, "domain": {{"periodic_z": [0, 0.003]}}, {grains}, {ts}}}"#));
+    assert!(e.contains("domain.periodic_z") && e.contains("4 r_max"), "{e}");
+    let e = refused(&format!(r#"{{"name": "a", "dimension": 3, "domain": {{"periodic_z": [0.002, 0.01]}}, {grains}, {ts}}}"#));
+    assert!(e.contains("domain.periodic_z") && e.contains("z = 0.001 m"), "{e}");
+    let mut s = grainlab::scene::builtin::builtin("shear3d").unwrap();
+    s.domain.periodic_z = Some([0.0, 0.0008]);
+    if let Grains::Pack(p) = &mut s.grains {
+        p.z = Some([0.0, 0.0008]);
+    }
+    s.walls.as_mut().unwrap().bottom.surface = grainlab::scene::SurfaceSpec::Rough { radius: 0.5e-3 };
+    let e = s.validate().err().expect("refused").to_string();
+    assert!(e.contains("walls.bottom.surface.rough.radius") && e.contains("along z"), "{e}");
+}

@@ -147,6 +147,16 @@ pub fn periodic_cell<D: Dim>(boundary: &Boundary<D>, p: &Particles<D>) -> Result
             format!("a periodic cell that holds every grain (grain {i} is at x = {} m)", p.x[i][0]),
         ));
     }
+    // Along z in space, alike.
+    if boundary.is_periodic_z() {
+        let (a, b) = (boundary.z_min, boundary.z_min + boundary.z_period);
+        if boundary.z_period < 4.0 * r_max {
+            return Err(refuse("domain.periodic_z", format!("[{a}, {b}]"), format!("a cell at least 4 r_max = {} m long (two diameters of the largest grain)", 4.0 * r_max)));
+        }
+        if let Some(i) = (0..p.n_free).find(|&i| !(p.x[i][D::D - 1] >= a && p.x[i][D::D - 1] <= b)) {
+            return Err(refuse("domain.periodic_z", format!("[{a}, {b}]"), format!("a periodic cell that holds every grain (grain {i} is at z = {} m)", p.x[i][D::D - 1])));
+        }
+    }
     Ok(())
 }
 

@@ -178,16 +178,8 @@ impl<'de> Deserialize<'de> for Coords {
             fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
                 f.write_str("2 numbers [x, y], or 3 [x, y, z] in a 3D scene")
             }
-            fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Coords, A::Error> {
-                let mut c = [0.0; 3];
-                let mut len = 0;
-                while let Some(x) = seq.next_element::<f64>()? {
-                    if len == 3 {
-                        return Err(A::Error::invalid_length(4, &self));
-                    }
-                    c[len] = x;
-                    len += 1;
-                }
+            fn visit_seq<A: SeqAccess<'de>>(self, seq: A) -> Result<Coords, A::Error> {
+                let (c, len) = up_to_three(seq, &self)?;
                 if len < 2 {
                     return Err(A::Error::invalid_length(len, &self));
                 }
@@ -196,6 +188,21 @@ impl<'de> Deserialize<'de> for Coords {
         }
         d.deserialize_seq(Numbers)
     }
+}
+
+/// At most three numbers of a JSON array and how many there were; a fourth is refused
+/// (`expected` says what the field takes) before anything is stored.
+fn up_to_three<'de, A: serde::de::SeqAccess<'de>>(mut seq: A, expected: &dyn serde::de::Expected) -> Result<([f64; 3], usize), A::Error> {
+    let mut c = [0.0; 3];
+    let mut len = 0;
+    while let Some(x) = seq.next_element::<f64>()? {
+        if len == 3 {
+            return Err(serde::de::Error::invalid_length(4, expected));
+        }
+        c[len] = x;
+        len += 1;
+    }
+    Ok((c, len))
 }
 
 impl JsonSchema for Coords {
@@ -304,16 +311,8 @@ impl<'de> Deserialize<'de> for SpinSpec {
             fn visit_u64<E: Error>(self, w: u64) -> Result<SpinSpec, E> {
                 Ok(SpinSpec::AboutZ(w as f64))
             }
-            fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<SpinSpec, A::Error> {
-                let mut w = [0.0; 3];
-                let mut len = 0;
-                while let Some(x) = seq.next_element::<f64>()? {
-                    if len == 3 {
-                        return Err(A::Error::invalid_length(4, &self));
-                    }
-                    w[len] = x;
-                    len += 1;
-                }
+            fn visit_seq<A: SeqAccess<'de>>(self, seq: A) -> Result<SpinSpec, A::Error> {
+                let (w, len) = up_to_three(seq, &self)?;
                 if len < 3 {
                     return Err(A::Error::invalid_length(len, &self));
                 }

@@ -183,6 +183,9 @@ impl Scene {
                     if let Some([a, b]) = self.domain.periodic_x {
                         check(2.0 * radius <= b - a, &format!("{at}.surface.rough"), "radius", radius, &format!("<= {} m, half the periodic cell's length (one glued grain must fit in it)", 0.5 * (b - a)))?;
                     }
+                    if let Some([a, b]) = self.domain.periodic_z {
+                        check(2.0 * radius <= b - a, &format!("{at}.surface.rough"), "radius", radius, &format!("<= {} m, half the periodic cell's length along z (one glued grain must fit in it)", 0.5 * (b - a)))?;
+                    }
                 }
                 if let ControlSpec::Pressure(p) = s.control {
                     check(name == "top", &at, "control", "pressure", "fixed (only the top wall carries a load)")?;
