@@ -49,7 +49,7 @@ fn contact_kernel(c: &mut Criterion) {
     use std::hint::black_box;
     // A sticking glass-glass contact of two 0.5 mm beads at a typical shear-cell overlap.
     let pm = PairMaterial::mix(&Material::default(), &Material::default());
-    let input = ContactInput {
+    let input: ContactInput<f64, grainlab::physics::dim::Plane> = ContactInput {
         n: Vec2::new(0.6, 0.8),
         dn: 1e-6,
         r_star: 2.5e-4,
@@ -64,7 +64,7 @@ fn contact_kernel(c: &mut Criterion) {
     };
     let options = ModelOptions { limit_force: false, lever_arm: LeverArm::Radius };
     let mut ledger = EnergyLedger::default();
-    let l = LiggghtsHertzHistory::new(options, Hertz);
+    let l: LiggghtsHertzHistory = LiggghtsHertzHistory::new(options, Hertz);
     let mut h = ContactHistory::default();
     c.bench_function("contact_kernel_liggghts_history", |b| b.iter(|| l.touch::<false>(black_box(&input), &pm, &mut h, &mut ledger)));
     // Four such contacts at once in SIMD lanes (one iteration = four contacts).
@@ -91,12 +91,12 @@ fn contact_kernel(c: &mut Criterion) {
         let mut h = (<grainlab::physics::contact::tangential::TotalDisplacement as grainlab::physics::contact::tangential::Tangential>::gather([&xi; 4]), ());
         c.bench_function("contact_kernel_liggghts_history_four_lanes", |b| b.iter(|| l.force(black_box(&lanes), &pml, &mut h)));
     }
-    let y = YadeMindlin::new(options, Hertz);
+    let y: YadeMindlin = YadeMindlin::new(options, Hertz);
     let mut h = ContactHistory::default();
     c.bench_function("contact_kernel_yade_mindlin", |b| b.iter(|| y.touch::<false>(black_box(&input), &pm, &mut h, &mut ledger)));
     // The linear spring, derived per pair (a fifth root per contact) and given.
     for (name, spring) in [("contact_kernel_hooke_derived", Hooke::Derived { vc: 1.0 }), ("contact_kernel_hooke_given", Hooke::Given { kn: 2e5, kt: 1.5e5 })] {
-        let k = LiggghtsHookeHistory::new(options, spring);
+        let k: LiggghtsHookeHistory = LiggghtsHookeHistory::new(options, spring);
         let mut h = ContactHistory::default();
         c.bench_function(name, |b| b.iter(|| k.touch::<false>(black_box(&input), &pm, &mut h, &mut ledger)));
     }
