@@ -186,7 +186,9 @@ fn bases(dir: &Path) -> Vec<Value> {
                             {"x": [0.0025, 0.0015, 0.002], "v": [-0.5, -0.3, -0.4], "r": 0.001}]},
         "model": {"tangential": "total_force_cap", "general_damping": 10.0},
         "time_step": {"rule": {"steps_per_contact": {"steps": 50, "impact_speed": 1.0}}},
-        "duration": 0.004, "output": {"samples": 10, "frames": 2}}));
+        "duration": 0.004, "output": {"samples": 10, "frames": 2}, "analysis": "impact"}));
+    // The built-in oblique impact on a wall in space (its tangent out of the x-y plane).
+    out.push(json(&builtin::builtin("oblique3d").unwrap()));
     out
 }
 

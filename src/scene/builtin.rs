@@ -13,6 +13,8 @@ pub const BUILTIN: &[(&str, &str)] = &[
     ("shear", "the seed's experiment: ~1000 polydisperse glass beads, periodic x, rough walls at +-0.5 m/s under 100 kPa"),
     ("protocol", "the shear cell as a study runs it, in four stages: compress to 100 kPa, relax, shear at +-0.5 m/s, shear at +-2 m/s"),
     ("shear3d", "the shear box in 3D: 2000 polydisperse glass spheres, periodic x and z, rough walls (glued lattices) at +-0.5 m/s under 100 kPa"),
+    ("collision3d", "two glass spheres head-on at 1 m/s along the skew line (2, 1, 2)/3 in 3D, e = 0.5"),
+    ("oblique3d", "a glass sphere hitting a flat glass wall at 45 degrees and 1 m/s in 3D, its tangential velocity along (3, 0, 4)/5 (out of the x-y plane), e = 0.9, mu = 0.5"),
 ];
 
 fn glass(restitution: f64) -> Material {
@@ -192,6 +194,38 @@ pub fn shear3d() -> Scene {
     s
 }
 
+/// [`head_on`] in space: two spheres of radius `r` meeting at relative speed `v` along the
+/// unit line `axis` (the plane's head-on impact turned onto it: the same gap, time step
+/// and duration).
+pub fn head_on_space(material: Material, r: f64, v: f64, steps_per_contact: f64, axis: [f64; 3]) -> Scene {
+    let mut s = head_on(material, r, v, steps_per_contact);
+    let Grains::List(g) = &mut s.grains else { unreachable!("head_on lists its grains") };
+    for q in g.iter_mut() {
+        let (x, vx) = (q.x[0], q.v[0]);
+        q.x = axis.map(|a| a * x).into();
+        q.v = axis.map(|a| a * vx).into();
+    }
+    s.name = "collision3d".into();
+    s.description = BUILTIN[5].1.into();
+    s.dimension = Dimension::Three;
+    s
+}
+
+/// [`oblique`] in space: a sphere hitting the flat bottom wall at `angle_deg` from its
+/// normal, its tangential velocity along the unit x-z direction `along` (the plane's
+/// `oblique` has it along x).
+pub fn oblique_space(material: Material, r: f64, v: f64, angle_deg: f64, tangential: TangentialSpec, steps_per_contact: f64, along: [f64; 2]) -> Scene {
+    let mut s = oblique(material, r, v, angle_deg, tangential, steps_per_contact);
+    let Grains::List(g) = &mut s.grains else { unreachable!("oblique lists its grain") };
+    let (vt, vy, y) = (g[0].v[0], g[0].v[1], g[0].x[1]);
+    g[0].x = [0.0, y, 0.0].into();
+    g[0].v = [vt * along[0], vy, vt * along[1]].into();
+    s.name = "oblique3d".into();
+    s.description = BUILTIN[6].1.into();
+    s.dimension = Dimension::Three;
+    s
+}
+
 /// The shear cell in a four-stage protocol: the packing is compressed under 100 kPa with
 /// the walls at rest, relaxes under the load, is sheared with the walls at +-0.5 m/s and
 /// then at +-2 m/s. The time step is set for contacts at 2 m/s, the fastest stage's
@@ -273,6 +307,8 @@ pub fn builtin(name: &str) -> Option<Scene> {
         "shear" => Some(shear()),
         "protocol" => Some(protocol()),
         "shear3d" => Some(shear3d()),
+        "collision3d" => Some(head_on_space(glass(0.5), 1e-3, 1.0, 200.0, [2.0 / 3.0, 1.0 / 3.0, 2.0 / 3.0])),
+        "oblique3d" => Some(oblique_space(glass(0.9), 1e-3, 1.0, 45.0, TangentialSpec::TotalDisplacement, 200.0, [0.6, 0.8])),
         _ => None,
     }
 }

@@ -99,9 +99,6 @@ impl Scene {
                 if self.output.contacts {
                     not_yet("output", "contacts", &true, "false (the contact record and the packing observers are the plane's)")?;
                 }
-                if self.analysis == Analysis::Impact {
-                    not_yet("", "analysis", &"\"impact\"", "\"none\" or \"shear\" (the impact observer is the plane's)")?;
-                }
                 if let Some(t) = self.walls.as_ref().and_then(|w| w.thickness) {
                     check(false, "walls", "thickness", t, "absent in a 3D scene: the walls' area is the cell's x length times its z length")?;
                 }

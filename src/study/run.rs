@@ -19,7 +19,7 @@ use crate::engine::world::MotionChange;
 use crate::study::protocol::{Phase, phases};
 use crate::error::Error;
 use crate::observe::energy::energy_summary;
-use crate::observe::impact::ImpactObserver;
+use crate::observe::impact::{ImpactObserver, Impacts};
 use crate::observe::packing::{PackingRow, packing_row, packing_summary};
 use crate::observe::profiles::{LayerProfile, ProfileSample, layer_count, mean_diameter, profile_sample, profile_summary};
 use crate::observe::stats::Blocking;
@@ -87,15 +87,13 @@ impl Outputs {
 
 /// What running a scene does differently in the plane and in space: the ParaView frames
 /// (the plane's carry the contacts), the observers that are the plane's so far (the
-/// impact observer and the packing's inside: a 3D scene's validation refuses them by
-/// name), and the volume the grains' solid fraction is of. The run loop is written once
+/// packing's inside: a 3D scene's validation refuses `output.contacts` by name), and the
+/// volume the grains' solid fraction is of. The run loop is written once
 /// ([`drive`]).
-pub trait Running: crate::engine::build::Building {
+pub trait Running: crate::engine::build::Building + Impacts {
     fn frame(vtk: &mut VtkSeries, e: &View<'_, Self>, contacts: bool, folder: &mut OutFolder) -> Result<(), Error>;
-    /// The impact observer's start and step (the plane's).
-    fn impact(o: &mut ImpactObserver, e: &View<'_, Self>, start: bool);
     /// The packing's row and the profiles' sample of the contacts recorded now (the plane's).
-    fn inside(st: &mut LoopState, e: &View<'_, Self>, out: &mut Outputs, stage: &str, length: f64, depth: f64) -> Result<(), Error>;
+    fn inside(st: &mut LoopState<Self>, e: &View<'_, Self>, out: &mut Outputs, stage: &str, length: f64, depth: f64) -> Result<(), Error>;
     /// The cell's measure between the walls a gap apart, per the grains' measure
     /// ([`crate::engine::build::Building::measure`]): its area in the plane (length x
     /// gap), its volume in space (length x depth x gap).
@@ -105,9 +103,6 @@ pub trait Running: crate::engine::build::Building {
 impl Running for Plane {
     fn frame(vtk: &mut VtkSeries, e: &View<'_>, contacts: bool, folder: &mut OutFolder) -> Result<(), Error> {
         vtk.frame(e, contacts, folder)
-    }
-    fn impact(o: &mut ImpactObserver, e: &View<'_>, start: bool) {
-        if start { o.start(e) } else { o.observe(e) }
     }
     fn inside(st: &mut LoopState, v: &View<'_>, out: &mut Outputs, stage: &str, length: f64, depth: f64) -> Result<(), Error> {
         if let Some(row) = packing_row(v, length, depth) {
@@ -131,10 +126,8 @@ impl Running for Space {
     fn frame(vtk: &mut VtkSeries, e: &View<'_, Space>, _: bool, folder: &mut OutFolder) -> Result<(), Error> {
         vtk.frame_of(e, folder)
     }
-    // A 3D scene's validation refuses `analysis: "impact"` and `output.contacts`: no
-    // observer to feed.
-    fn impact(_: &mut ImpactObserver, _: &View<'_, Space>, _: bool) {}
-    fn inside(_: &mut LoopState, _: &View<'_, Space>, _: &mut Outputs, _: &str, _: f64, _: f64) -> Result<(), Error> {
+    // A 3D scene's validation refuses `output.contacts`: no observer to feed.
+    fn inside(_: &mut LoopState<Space>, _: &View<'_, Space>, _: &mut Outputs, _: &str, _: f64, _: f64) -> Result<(), Error> {
         Ok(())
     }
     fn cell_measure(length: f64, depth: f64, gap: f64) -> f64 {
@@ -231,7 +224,7 @@ where
     if theirs != resolved_json(&run_scene) {
         return refuse(format!("belongs to another run than this folder's {RESOLVED_SCENE} (the scenes differ)"));
     }
-    let state: LoopState = match postcard::from_bytes(&c.run) {
+    let state: LoopState<D> = match postcard::from_bytes(&c.run) {
         Ok(s) => s,
         Err(e) => return refuse(format!("its run state does not decode ({e})")),
     };
@@ -258,7 +251,8 @@ fn resolved_json(scene: &Scene) -> String {
 /// What the run loop carries besides the engine, saved in a checkpoint: the observers'
 /// accumulators, the rows so far, what the outputs hold, and the run's clock.
 #[derive(Default, Serialize, Deserialize)]
-pub struct LoopState {
+#[serde(bound = "")]
+pub struct LoopState<D: Impacts = Plane> {
     walls_avg: WallAverager,
     wall_rows: Vec<WallRow>,
     /// The rows each stage ended at (an index into `wall_rows`), as the stages end.
@@ -268,7 +262,7 @@ pub struct LoopState {
     /// The last energy row recorded (of a state that passed its checks): the summary's,
     /// so that a run stopped on a state gone wrong reports the last one that was not.
     last_row: Option<EnergyRow>,
-    impact: Option<ImpactObserver>,
+    impact: Option<ImpactObserver<D>>,
     /// Bytes of energy.csv and walls.csv written (none: the run writes no such series).
     energy_bytes: Option<u64>,
     walls_bytes: Option<u64>,
@@ -289,10 +283,10 @@ pub struct LoopState {
     resumed: Vec<u64>,
 }
 
-impl LoopState {
+impl<D: Running> LoopState<D> {
     /// Record the energy balance now (with the ledger on): its residual, and a row of
     /// energy.csv.
-    fn record_energy<D: Running>(&mut self, e: &dyn Engine<D>, out: &mut Outputs, stage: &str, energy_on: bool) -> Result<(), Error> {
+    fn record_energy(&mut self, e: &dyn Engine<D>, out: &mut Outputs, stage: &str, energy_on: bool) -> Result<(), Error> {
         if energy_on {
             let row = e.energy_row();
             self.max_res = self.max_res.max(row.residual_j.abs() / row.put_in().max(f64::MIN_POSITIVE));
@@ -308,7 +302,7 @@ impl LoopState {
     /// and with `inside` (the contacts recorded at this step) the packing row and the
     /// profiles' sample.
     #[allow(clippy::too_many_arguments)]
-    fn sample<D: Running>(&mut self, e: &dyn Engine<D>, out: &mut Outputs, stage: &str, energy_on: bool, inside: bool, length: f64, depth: f64) -> Result<(), Error> {
+    fn sample(&mut self, e: &dyn Engine<D>, out: &mut Outputs, stage: &str, energy_on: bool, inside: bool, length: f64, depth: f64) -> Result<(), Error> {
         self.record_energy(e, out, stage, energy_on)?;
         if let Some(row) = self.walls_avg.row(&e.view(), length, depth) {
             if let Some(w) = out.walls.as_mut() {
@@ -345,7 +339,7 @@ struct Checkpointing<'a> {
 impl Checkpointing<'_> {
     /// Write `checkpoint.bin` for the state after this step: the series flushed and synced
     /// first (the checkpoint holds their lengths), then the checkpoint, synced and renamed.
-    fn write<D: Running>(&self, e: &dyn Engine<D>, out: &mut Outputs, st: &mut LoopState, wall_time_s: f64) -> Result<(), Error> {
+    fn write<D: Running>(&self, e: &dyn Engine<D>, out: &mut Outputs, st: &mut LoopState<D>, wall_time_s: f64) -> Result<(), Error> {
         let Some(folder) = out.folder.as_mut() else { return Ok(()) };
         st.energy_bytes = out.energy.as_mut().map(|s| s.written(true)).transpose()?;
         st.walls_bytes = out.walls.as_mut().map(|s| s.written(true)).transpose()?;
@@ -372,7 +366,7 @@ impl Checkpointing<'_> {
 
 /// The run loop, from the start or (`resumed`: the outputs reopened and the loop's state;
 /// the engine restored) from a checkpoint.
-fn drive<D: Running>(scene: &Scene, mut built: Built<D>, opts: &RunOptions, resumed: Option<(Outputs, LoopState)>) -> Result<RunReport, Error> {
+fn drive<D: Running>(scene: &Scene, mut built: Built<D>, opts: &RunOptions, resumed: Option<(Outputs, LoopState<D>)>) -> Result<RunReport, Error> {
     let duration = opts.duration.unwrap_or(scene.duration);
     let dt = built.time_step.dt_s;
     // The build checked the scene's duration; an override is checked here, and cuts a
@@ -438,7 +432,7 @@ fn drive<D: Running>(scene: &Scene, mut built: Built<D>, opts: &RunOptions, resu
     let mut error: Option<Error> = None;
     if fresh {
         if let Some(o) = st.impact.as_mut() {
-            D::impact(o, &e.view(), true);
+            o.start(&e.view());
         }
         error = st.record_energy(e, &mut outputs, first_stage, energy_on).and_then(|()| outputs.frame(e, false)).err();
     }
@@ -517,7 +511,7 @@ fn drive<D: Running>(scene: &Scene, mut built: Built<D>, opts: &RunOptions, resu
                     error = Some(err);
                     break 'run;
                 }
-                D::impact(o, &e.view(), false);
+                o.observe(&e.view());
             }
             st.walls_avg.accumulate(&e.view());
             // Nothing is written of a state that failed its check: outputs hold only
