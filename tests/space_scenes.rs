@@ -235,7 +235,8 @@ fn turned(scene: &Scene, rot: &nalgebra::Rotation3<f64>) -> Scene {
 /// law (its tangential force turned with the contact frame, twist included), turned
 /// about a skew axis; the same impact lifted into space untouched. Bound: 1e-9 of each
 /// quantity's scale (the turned positions and velocities differ from the plane's in their
-/// last bits, and the contact's few hundred steps carry that; measured below 1e-11).
+/// last bits, and the contact's few hundred steps carry that; measured below 1e-11); in
+/// space nothing leaves the impact's plane, to the same bound.
 #[test]
 fn impacts_turned_out_of_the_plane_measure_as_in_the_plane() {
     let glass = grainlab::physics::material::Material { restitution: 0.7, ..Default::default() };
@@ -272,6 +273,13 @@ fn impacts_turned_out_of_the_plane_measure_as_in_the_plane() {
             assert!((x - y).abs() <= 1e-9 * scale, "{name}: {what} {x} in the plane, {y} in space");
         }
         assert!(q.momentum_error_rel < 1e-12, "{name}: momentum error {}", q.momentum_error_rel);
+        // Nothing leaves the impact's plane: grain 0's velocity along b and its spin about
+        // t and n are 0 to the same bound (the plane's summary has none of them).
+        assert!(p.rebound_binormal_velocity_m_s.is_none() && p.rebound_spin_tangential_rad_s.is_none() && p.rebound_spin_normal_rad_s.is_none(), "{name}: out-of-plane values in the plane");
+        let out = [(q.rebound_binormal_velocity_m_s, v), (q.rebound_spin_tangential_rad_s, v / 1e-3), (q.rebound_spin_normal_rad_s, v / 1e-3)];
+        for (x, scale) in out {
+            assert!(x.is_some_and(|x| x.abs() <= 1e-9 * scale), "{name}: out of the impact's plane {out:?}");
+        }
         eprintln!("{name}: e_n {} / {}, spin {} / {}", p.restitution_normal, q.restitution_normal, p.rebound_spin_rad_s, q.rebound_spin_rad_s);
     }
 }

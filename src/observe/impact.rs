@@ -54,6 +54,18 @@ pub struct ImpactSummary {
     pub contact_time_s: f64,
     /// Largest |momentum change| of the two grains over the run relative to the initial momentum scale.
     pub momentum_error_rel: f64,
+    /// In space, grain 0's velocity after the impact out of the impact's plane (along
+    /// `b = t x n`), m/s; absent in the plane.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rebound_binormal_velocity_m_s: Option<f64>,
+    /// In space, grain 0's spin after the impact about its tangent `t`, rad/s (a spin
+    /// about a second axis); absent in the plane.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rebound_spin_tangential_rad_s: Option<f64>,
+    /// In space, grain 0's spin after the impact about the normal `n` (twist), rad/s;
+    /// absent in the plane.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rebound_spin_normal_rad_s: Option<f64>,
 }
 
 /// A contact as the observer keeps it from one step to the next: its normal (grain 1 to
@@ -104,6 +116,8 @@ pub struct Rebound {
     pub tangential: f64,
     pub normal: f64,
     pub spin: f64,
+    /// In space: grain 0's velocity along `b`, its spin about `t` and about `n` after.
+    pub out_of_plane: Option<[f64; 3]>,
 }
 
 impl Impacts for Plane {
@@ -141,7 +155,7 @@ impl Impacts for Plane {
     fn rebound(before: &Contact, after: &Contact, v0: Vec2, w0: f64) -> Rebound {
         let n = after.n;
         let t = Vec2::new(n.y, -n.x);
-        Rebound { vt_before: before.vt, vt_after: after.vt, tangential: v0.dot(&t), normal: v0.dot(&n), spin: w0 }
+        Rebound { vt_before: before.vt, vt_after: after.vt, tangential: v0.dot(&t), normal: v0.dot(&n), spin: w0, out_of_plane: None }
     }
 }
 
@@ -186,7 +200,14 @@ impl Impacts for Space {
         };
         let b = t.cross(&nb);
         let ta = after.n.cross(&b);
-        Rebound { vt_before: before.vt.dot(&t), vt_after: after.vt.dot(&ta), tangential: v0.dot(&ta), normal: v0.dot(&after.n), spin: w0.dot(&b) }
+        Rebound {
+            vt_before: before.vt.dot(&t),
+            vt_after: after.vt.dot(&ta),
+            tangential: v0.dot(&ta),
+            normal: v0.dot(&after.n),
+            spin: w0.dot(&b),
+            out_of_plane: Some([v0.dot(&b), w0.dot(&ta), w0.dot(&after.n)]),
+        }
     }
 }
 
@@ -338,6 +359,9 @@ impl<D: Impacts> ImpactObserver<D> {
             peak_force_n: self.peak(|c| c.normal_force_n),
             contact_time_s: self.t_end? - self.t_start?,
             momentum_error_rel: self.max_dp,
+            rebound_binormal_velocity_m_s: r.out_of_plane.map(|o| o[0]),
+            rebound_spin_tangential_rad_s: r.out_of_plane.map(|o| o[1]),
+            rebound_spin_normal_rad_s: r.out_of_plane.map(|o| o[2]),
         })
     }
 }

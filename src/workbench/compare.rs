@@ -116,6 +116,17 @@ pub fn compare_impact(case: &str, code: Code, engine: &ImpactSummary, reference:
             true,
         ));
     }
+    // In space, grain 0's velocity out of the impact's plane and its spin about the two
+    // other axes, as fractions of the impact speed and of the largest spin component
+    // (each of them may be 0 where the other is not: compared absolutely on that scale).
+    if let (Some(vb), Some(st), Some(sn)) = (reference.rebound_binormal_velocity_m_s, reference.rebound_spin_tangential_rad_s, reference.rebound_spin_normal_rad_s) {
+        let (ev, et, en) = (engine.rebound_binormal_velocity_m_s.unwrap_or(f64::NAN), engine.rebound_spin_tangential_rad_s.unwrap_or(f64::NAN), engine.rebound_spin_normal_rad_s.unwrap_or(f64::NAN));
+        let v = reference.impact_speed_m_s.abs().max(f64::MIN_POSITIVE);
+        let w = reference.rebound_spin_rad_s.abs().max(st.abs()).max(sn.abs()).max(f64::MIN_POSITIVE);
+        rows.push(Row::new(case, code, "rebound_binormal_velocity_over_impact_speed", ev / v, vb / v, tolerance::SPIN, false));
+        rows.push(Row::new(case, code, "rebound_spin_tangential_over_largest_spin", et / w, st / w, tolerance::SPIN, false));
+        rows.push(Row::new(case, code, "rebound_spin_normal_over_largest_spin", en / w, sn / w, tolerance::SPIN, false));
+    }
     rows
 }
 
