@@ -396,13 +396,48 @@ fn bases(dir: &Path) -> Vec<Base> {
     let variant = |name, s: &Scene, of, leaf, only| Base { name, scene: json_of(s), only, variant_of: Some((of, leaf)) };
     let mut out = vec![base("collision", &collision), base("oblique", &oblique), base("shear", &shear)];
     // The dimension given (2 is left out of written scenes): set to 3, the same grains in
-    // space, which every export refuses by name.
+    // space, whose decks are the 3D ones.
     // (Its analysis none: the impact observer is the plane's, and a 3D scene asking for it
     // is refused when read.)
     let mut planar = json_of(&collision);
     planar["dimension"] = json!(2);
     planar["analysis"] = json!("none");
     out.push(Base { name: "collision, dimension given", scene: planar, only: &["dimension"], variant_of: None });
+    // 3D scenes (analysis none, as above): two spheres meeting off centre, spinning about
+    // skew axes, each vector and spin of three components; a sphere on the flat walls
+    // with a z velocity; a small shear box periodic in x and z between rough lattices, the
+    // top one loaded.
+    let mut pair3d = json_of(&collision);
+    pair3d["dimension"] = json!(3);
+    pair3d["analysis"] = json!("none");
+    let x0 = pair3d["grains"]["list"][0]["x"][0].as_f64().unwrap();
+    pair3d["grains"]["list"][0]["x"] = json!([x0, 0.0, -0.2e-3]);
+    pair3d["grains"]["list"][0]["v"] = json!([0.5, 0.0, 0.1]);
+    pair3d["grains"]["list"][0]["omega"] = json!([10.0, -20.0, 5.0]);
+    pair3d["grains"]["list"][1]["x"] = json!([-x0, 0.1e-3, 0.2e-3]);
+    pair3d["grains"]["list"][1]["v"] = json!([-0.5, 0.0, -0.1]);
+    pair3d["grains"]["list"][1]["omega"] = json!([0.0, 3.0, 0.0]);
+    // Periodic along z: the open YADE script has no periodic cell (refused by name).
+    let mut periodic = pair3d.clone();
+    periodic["domain"]["periodic_z"] = json!([-0.01, 0.01]);
+    out.push(Base { name: "pair3d-periodic-z", scene: periodic, only: &["domain.periodic_z"], variant_of: Some(("pair3d", "domain.periodic_z")) });
+    out.push(Base { name: "pair3d", scene: pair3d, only: &["grains.list", "dimension"], variant_of: None });
+    let mut wall3d = json_of(&oblique);
+    wall3d["dimension"] = json!(3);
+    wall3d["analysis"] = json!("none");
+    let [x, y] = [0, 1].map(|k| wall3d["grains"]["list"][0]["x"][k].as_f64().unwrap());
+    let [vx, vy] = [0, 1].map(|k| wall3d["grains"]["list"][0]["v"][k].as_f64().unwrap());
+    wall3d["grains"]["list"][0]["x"] = json!([x, y, 0.0]);
+    wall3d["grains"]["list"][0]["v"] = json!([vx, vy, 0.3]);
+    out.push(Base { name: "wall3d", scene: wall3d, only: &["grains.list", "walls"], variant_of: None });
+    let mut s = builtin::shear3d();
+    s.domain = Domain { periodic_x: Some([0.0, 0.004]), periodic_z: Some([0.0, 0.004]) };
+    if let Grains::Pack(p) = &mut s.grains {
+        (p.count, p.x, p.z) = (40, [0.0, 0.004], Some([0.0, 0.004]));
+    }
+    s.duration = 2e-4;
+    s.output.frames = 0;
+    out.push(focus("shear3d", &s, &["dimension", "domain", "grains.pack", "walls"]));
 
     // Two materials (one restitution, as YADE needs), the second grain of the second.
     let mut s = collision.clone();
@@ -809,8 +844,7 @@ fn one_value_fields_admit_no_other_value() {
     s["stages"][1]["walls"]["bottom"]["control"] = json!({"pressure": 1e5});
     let e = Scene::from_json(&s.to_string()).expect_err("a loaded bottom wall is refused");
     assert!(e.to_string().contains("stages[1].walls.bottom.control"), "{e}");
-    // A 3D scene's own fields are refused in a 2D scene (and a 3D scene's export as a
-    // whole, by its dimension: the_exporter_keeps_every_decision).
+    // A 3D scene's own fields are refused in a 2D scene.
     let mut s = json_of(&grainlab::scene::builtin::shear_cell(60, 0.004));
     s["domain"]["periodic_z"] = json!([0.0, 0.004]);
     let e = Scene::from_json(&s.to_string()).expect_err("a periodic z in 2D is refused");
@@ -819,9 +853,8 @@ fn one_value_fields_admit_no_other_value() {
     s["grains"]["pack"]["z"] = json!([0.0, 0.004]);
     let e = Scene::from_json(&s.to_string()).expect_err("a packing's z range in 2D is refused");
     assert!(e.to_string().contains("grains.pack.z") && e.to_string().contains("dimension"), "{e}");
-    let space_only = ["domain.periodic_z", "grains.pack.z"];
     for f in FIELDS.iter().filter(|f| f.liggghts.one_value.is_some() || f.yade.one_value.is_some()) {
-        assert!(f.path.starts_with("walls.bottom.control") || f.path.starts_with("stages[].walls.bottom.control") || space_only.contains(&f.path), "{}: a one-value field this test does not try", f.path);
+        assert!(f.path.starts_with("walls.bottom.control") || f.path.starts_with("stages[].walls.bottom.control"), "{}: a one-value field this test does not try", f.path);
     }
 }
 

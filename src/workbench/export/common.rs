@@ -6,7 +6,7 @@ use std::fmt::Write as _;
 
 use serde::Serialize;
 
-use crate::scene::Analysis;
+use crate::scene::{Analysis, Dimension};
 
 /// The reference codes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, clap::ValueEnum, Serialize, serde::Deserialize)]
@@ -39,6 +39,11 @@ impl Code {
 #[derive(Clone, Debug, Serialize, serde::Deserialize)]
 pub struct ExportInfo {
     pub scene: String,
+    /// The scene's dimension: 2 (spheres in the plane, the default, left out of the file
+    /// so that a 2D export.json keeps its bytes) or 3 (spheres in space: 3-component
+    /// columns, [`impact_columns_in`] and [`wall_columns_in`]).
+    #[serde(default, skip_serializing_if = "Dimension::is_two")]
+    pub dimension: Dimension,
     /// `impact` (writes series.txt) or `shear` (writes walls.txt).
     pub analysis: Analysis,
     pub time_step_s: f64,
@@ -46,14 +51,16 @@ pub struct ExportInfo {
     /// Steps per row of walls.txt.
     pub sample_every: u64,
     pub free_grains: usize,
-    /// Length of the periodic cell, m, and depth for stresses, m (shear scenes).
+    /// Length of the periodic cell (x), m, and depth for stresses, m (shear scenes): in 3D
+    /// the cell's z length the engine divides the wall forces by (`Built::depth`).
     pub length_m: f64,
     pub depth_m: f64,
     /// Radii, m, and masses, kg, of the free grains (impact scenes).
     pub radii_m: Vec<f64>,
     pub masses_kg: Vec<f64>,
     /// The flat wall an impact scene's grain hits: y (m), side (+1 bottom, -1 top),
-    /// x velocity (m/s).
+    /// x velocity (m/s). In 3D too: a wall's z velocity is always 0 (a scene gives walls
+    /// an x velocity only; the export refuses any other, by name).
     pub flat_wall: Option<[f64; 3]>,
     /// Columns of the raw output file.
     pub columns: Vec<String>,
@@ -98,9 +105,40 @@ pub fn impact_columns(two: bool) -> Vec<String> {
     c
 }
 
+/// Columns of series.txt for an impact scene with `two` grains (else one grain on a wall)
+/// in `dimension`: in 2D [`impact_columns`]; in 3D, after `step`, per grain k: `x_m{k}
+/// y_m{k} z_m{k}` (m), `vx_m_s{k} vy_m_s{k} vz_m_s{k}` (m/s), `omegax_rad_s{k}
+/// omegay_rad_s{k} omegaz_rad_s{k}` (rad/s), `fx_n{k} fy_n{k} fz_n{k}` (N).
+pub fn impact_columns_in(two: bool, dimension: Dimension) -> Vec<String> {
+    if dimension.is_two() {
+        return impact_columns(two);
+    }
+    let mut c = vec!["step".to_string()];
+    for k in 0..if two { 2 } else { 1 } {
+        for q in IMPACT_SPACE {
+            c.push(format!("{q}{k}"));
+        }
+    }
+    c
+}
+
+/// The quantities of one grain in a 3D series.txt row, in order ([`impact_columns_in`]).
+pub(crate) const IMPACT_SPACE: [&str; 12] = ["x_m", "y_m", "z_m", "vx_m_s", "vy_m_s", "vz_m_s", "omegax_rad_s", "omegay_rad_s", "omegaz_rad_s", "fx_n", "fy_n", "fz_n"];
+
 /// Columns of walls.txt.
 pub fn wall_columns() -> Vec<String> {
     ["step", "bottom_fx_n", "bottom_fy_n", "top_fx_n", "top_fy_n", "gap_m"].map(String::from).to_vec()
+}
+
+/// Columns of walls.txt in `dimension`: in 2D [`wall_columns`]; in 3D the walls' z forces
+/// too: `step bottom_fx_n bottom_fy_n bottom_fz_n top_fx_n top_fy_n top_fz_n gap_m`
+/// (forces in N on the wall from the grains, averaged over the row's interval; the gap, m,
+/// between the two walls' glued lattices at the row's step).
+pub fn wall_columns_in(dimension: Dimension) -> Vec<String> {
+    if dimension.is_two() {
+        return wall_columns();
+    }
+    ["step", "bottom_fx_n", "bottom_fy_n", "bottom_fz_n", "top_fx_n", "top_fy_n", "top_fz_n", "gap_m"].map(String::from).to_vec()
 }
 
 /// `s` as printable ASCII on one line: `\`, quotes, control and non-ASCII characters as
@@ -148,7 +186,7 @@ pub(crate) struct ContactKinds {
     pub walls: Vec<Vec<Vec<f64>>>,
 }
 
-pub(crate) fn contact_kinds(n: usize, p: &crate::physics::particles::Particles, walls: &[crate::physics::walls::Wall], key: impl Fn(usize, usize, f64, f64) -> f64) -> ContactKinds {
+pub(crate) fn contact_kinds<D: crate::physics::dim::Dim>(n: usize, p: &crate::physics::particles::Particles<D>, walls: &[crate::physics::walls::Wall<D>], key: impl Fn(usize, usize, f64, f64) -> f64) -> ContactKinds {
     let same = same_value;
     let add = |list: &mut Vec<f64>, k: f64| {
         if list.len() < 2 && !list.iter().any(|&v| same(k, v)) {
@@ -231,7 +269,7 @@ mod tests {
         let n = 100_000;
         let r: Vec<f64> = (0..n + 2).map(|k| 1e-3 * (1.0 + k as f64 / n as f64)).collect();
         let m_star = |_: usize, _: usize, m: f64, _: f64| m;
-        let kinds = contact_kinds(1, &grains(&r, n), &[], m_star);
+        let kinds = contact_kinds::<crate::physics::dim::Plane>(1, &grains(&r, n), &[], m_star);
         assert_eq!(kinds.pairs[0].len(), 2);
         // Two equal grains: one kind; a grain of each of two sizes: one kind (they meet
         // only each other); three sizes: two.

@@ -129,8 +129,8 @@ const MATERIAL_Y: &str = "flat: the wall body's material mats[k]; rough: the row
 const BOTTOM_CONTROL: &str = "\"fixed\": only the top wall carries a load (scene validation refuses a pressure on the bottom wall); the decks hold the bottom wall (a fixed plane, or a row at constant velocity)";
 const BOTTOM_MASS: &str = "the bottom wall is always held in y (only the top wall carries a load), so its mass has no effect, in grainlab either";
 const THICKNESS: &str = "export.json depth_m (wall forces to stresses), and the load p L_x t on a loaded top wall";
-const LIST_X: &str = "grains.data Atoms: x y (z = 0)";
-const LIST_V: &str = "grains.data Velocities: vx vy";
+const LIST_X: &str = "grains.data Atoms: x y (z = 0 in 2D; a 3D scene's x y z)";
+const LIST_V: &str = "grains.data Velocities: vx vy (vz = 0 in 2D; a 3D scene's vx vy vz)";
 const LIST_R: &str = "grains.data Atoms: diameter 2 r";
 const ATOM_TYPE: &str = "grains.data atom type (material + 1)";
 const NAME_M: &str = "the comments of in.lammps, the title line of grains.data, export.json `scene`; escaped to printable ASCII on one line (`\\`, quotes, control and non-ASCII characters as Rust escapes, `&` as `\\u{26}`): no line break starts a command and no comment ends in `&`, which LAMMPS too reads as a line continued by the next";
@@ -147,8 +147,8 @@ const SPRING_Y: &str = "the KN, KS (and CN, CS) lists of ViscElMat: twice the pa
 const SPRING_L: &str = "`fix m5 kn`, `fix m6 kt` per pair of atom types, and the damping rates gamman, gammat = -2 beta(e) sqrt(k / m*) (LIGGGHTS multiplies them by m*)";
 const SPRING_REFUSED_L: &str = "a pair of materials that meets at more than one reduced mass (grains of two sizes, or a grain and a flat wall): hooke/stiffness takes one damping rate per pair of atom types, times m*";
 const SPIN_NO_ROTATION: &str = "a non-zero spin with model.rotation = false (and friction): grainlab's grain-grain contacts then leave the spin out of the contact velocity, LIGGGHTS and LAMMPS (`nve`) and YADE (blocked rotation) keep the spin, which never changes, in it";
-const SPACE: &str = "3: a 3D scene's decks are not written yet (the exports are the plane's: spheres at z = 0 with z motion blocked); the 3D decks come with the 3D workbench cases";
-const SPACE_ONLY: &str = "absent: scene validation refuses it in a 2D scene, and a 3D scene is refused as a whole (see dimension)";
+const SPACE_L: &str = "2: spheres at z = 0 in a 3D box, which nothing moves out of the plane (`boundary X f f`, z bounds +-2 r_max); 3: spheres in space, no 2D constraint (no `enforce2d`, no `dimension 2`): `boundary X f Z` (p along a periodic x or z, else bounds that hold the grains for the run), each grain's z, vz and spin (wx, wy, wz) in grains.data, the rough walls' lattices of atoms (L_x by L_z) moved as one, series.txt and walls.txt with the z components (export.json dimension and columns)";
+const SPACE_Y: &str = "2: spheres with blockedDOFs 'zXY' (the sphere-in-plane model); 3: free spheres (no blocked DOF; 'XYZ' without rotation) with each grain's z, vz and spin (wx, wy, wz) from grains.data, the periodic cell periodic in z too where the scene is (else 10x the packing along z, as along y), the rough walls' lattices of spheres (L_x by L_z) blocked or clumped, series.txt and walls.txt with the z components (export.json dimension and columns)";
 const NOT_PHYSICS_OUTPUT: &str = "grainlab's own output";
 
 /// Every leaf of the scene schema and its decision for each code.
@@ -166,7 +166,7 @@ pub const FIELDS: &[Field] = &[
         refused("disks are not exported yet (see grain_shape)"),
         refused("disks cannot be expressed (see grain_shape)"),
     ),
-    both("dimension", refused(SPACE)),
+    each("dimension", written(SPACE_L), written(SPACE_Y)),
     both("materials[].name", outside("a label: the decks refer to materials by position (LIGGGHTS atom type k + 1, YADE mats[k])")),
     each("materials[].youngs_modulus", written("`fix m1 ... youngsModulus peratomtype`"), written("E[k], FrictMat(young)")).in_lammps(written(MODULI_M)),
     each(
@@ -216,10 +216,15 @@ pub const FIELDS: &[Field] = &[
         written("a periodic cell of length L from x_min (y and z 10x the packing: YADE cells are periodic in every direction)")
             .or_refused("an impact scene, or a scene without two rough walls: YADE's periodic script is the shear cell's (rough rows, the top one loaded or held); or a cell shorter than 4 r_max + 2 r_min: YADE's periodic collider stops on a body whose bounds (its diameter and twice the Verlet distance, by default half the smallest radius) span over half the cell"),
     ),
-    both("domain.periodic_z", one_value(SPACE_ONLY)),
+    each(
+        "domain.periodic_z",
+        written("3D: `boundary X f p` and the box's z bounds in grains.data"),
+        written("3D: the periodic cell's z length LZ from Z0 (the shear cell's script)")
+            .or_refused("without domain.periodic_x (YADE's periodic script is the shear cell's; the open script has no periodic cell), or a cell shorter along z than 4 r_max + 2 r_min (YADE's periodic collider, as along x)"),
+    ),
     both("grains.list[].x", written(LIST_X)),
     both("grains.list[].v", written(LIST_V)),
-    both("grains.list[].omega", written("grains.data Velocities: wz").or_refused(SPIN_NO_ROTATION)),
+    both("grains.list[].omega", written("grains.data Velocities: wz (wx = wy = 0 in 2D; a 3D scene's wx wy wz)").or_refused(SPIN_NO_ROTATION)),
     both("grains.list[].r", written(LIST_R)),
     both("grains.list[].material", written(ATOM_TYPE)),
     both("grains.file.path", written("grains.data: grainlab reads the file and writes its grains (the decks never read the path)")),
@@ -241,7 +246,7 @@ pub const FIELDS: &[Field] = &[
     both("grains.pack.material", written(ATOM_TYPE)),
     both("grains.pack.x", written(PACKED)),
     both("grains.pack.y_min", written(PACKED)),
-    both("grains.pack.z", one_value(SPACE_ONLY)),
+    both("grains.pack.z", written(PACKED)),
     both("grains.pack.packing_fraction", written(PACKED)),
     each("walls.bottom.y", written(Y_L), written(Y_Y)).in_lammps(written(Y_M)),
     each("walls.bottom.velocity_x", written(VX_L), written(VX_Y)),
@@ -274,14 +279,14 @@ pub const FIELDS: &[Field] = &[
     ),
     each(
         "walls.top.control.pressure",
-        written("the load p L_x t on the rough row: `setforce 0.0 NULL 0.0`, `aveforce NULL -F/n NULL` (per atom) and nve move it as one body of its atoms' mass")
+        written("the load p L_x t (3D: p L_x L_z) on the rough row (3D: lattice): `setforce 0.0 NULL 0.0`, `aveforce NULL -F/n NULL` (per atom) and nve move it as one body of its atoms' mass")
             .or_refused("on a flat wall: a primitive wall/gran plane cannot carry a load; use a rough wall"),
-        written("LOAD = p L_x t, a permanent force on the top row's clump (blockedDOFs 'xzXYZ')")
+        written("LOAD = p L_x t (3D: p L_x L_z), a permanent force on the top row's clump (blockedDOFs 'xzXYZ')")
             .or_refused("on a flat wall (a wall body cannot carry a load; use a rough wall), or without a periodic x (the script moves a loaded row in the periodic cell only, and holds rough rows elsewhere)")
             .or_differs("any", "YADE's leapfrog takes the initial velocities as v(-1/2), grainlab's velocity Verlet as v(0): bodies under a force at t = 0 (the loaded wall, touching grains) start O(a dt^2) apart, which a flow forgets"),
     )
     .in_lammps(
-        written("the load p L_x t on the rough row: `setforce 0.0 NULL 0.0`, `aveforce NULL -F/n NULL` (per atom) and nve move it as one body of its atoms' mass")
+        written("the load p L_x t (3D: p L_x L_z) on the rough row (3D: lattice): `setforce 0.0 NULL 0.0`, `aveforce NULL -F/n NULL` (per atom) and nve move it as one body of its atoms' mass")
             .or_refused("on a flat wall: a wall/gran plane cannot carry a load; use a rough wall"),
     ),
     each(
@@ -378,7 +383,7 @@ pub const FIELDS: &[Field] = &[
     each(
         "model.rotation",
         written("false: `fix nve` for the free grains instead of `nve/sphere`"),
-        written("false: blockedDOFs 'zXYZ' for the free grains instead of 'zXY'"),
+        written("false: blockedDOFs 'zXYZ' for the free grains instead of 'zXY' (3D: 'XYZ' instead of none)"),
     ),
     each(
         "model.general_damping",
@@ -463,8 +468,8 @@ pub const FIELDS: &[Field] = &[
     ),
     each(
         "stages[].walls.top.control.pressure",
-        written("the load p L_x t on the row: `aveforce NULL -F/n NULL` (per atom), replaced at the stage's start (a given walls.top.mass other than the row's atoms' is refused there)"),
-        written("LOAD = p L_x t in STAGES: setPermF on the top clump, free in y"),
+        written("the load p L_x t (3D: p L_x L_z) on the row: `aveforce NULL -F/n NULL` (per atom), replaced at the stage's start (a given walls.top.mass other than the row's atoms' is refused there)"),
+        written("LOAD = p L_x t (3D: p L_x L_z) in STAGES: setPermF on the top clump, free in y"),
     ),
     each("stages[].gravity", refused(STAGE_GRAVITY), refused(STAGE_GRAVITY)),
     each(

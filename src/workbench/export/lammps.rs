@@ -65,7 +65,7 @@ pub fn tsuji_input(alpha: f64) -> f64 {
 /// The kinds of contact the LAMMPS deck tells apart: by the derived spring's kn (LAMMPS
 /// takes one per pair of types and per wall fix); under the other laws every contact of a
 /// pair of types takes the same words.
-pub(crate) fn kinds(scene: &Scene, ex: &Exported) -> ContactKinds {
+pub(crate) fn kinds<D: crate::physics::dim::Dim>(scene: &Scene, ex: &Exported<D>) -> ContactKinds {
     let e = ex.built.engine.as_ref();
     let mats = &scene.materials;
     let derived = matches!(scene.model.normal, NormalLaw::Hooke { .. });
@@ -148,7 +148,7 @@ pub(crate) fn pair_style(w: &mut String, scene: &Scene, kinds: &ContactKinds) ->
 /// A flat wall: one `fix wall/gran granular` per material of the free grains, on the free
 /// grains of that material, with the coefficients of the pair (wall material, grain
 /// material); `plane` is its `yplane LO HI` and `shear x V` words.
-pub(crate) fn flat_wall(w: &mut String, scene: &Scene, ex: &Exported, kinds: &ContactKinds, index: usize, plane: &str) -> Result<(), Error> {
+pub(crate) fn flat_wall<D: crate::physics::dim::Dim>(w: &mut String, scene: &Scene, ex: &Exported<D>, kinds: &ContactKinds, index: usize, plane: &str) -> Result<(), Error> {
     let wall = &ex.built.engine.walls()[index];
     let mats = &scene.materials;
     let present: Vec<usize> = (0..mats.len()).filter(|&a| !kinds.walls[index][a].is_empty()).collect();

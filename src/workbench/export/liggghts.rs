@@ -11,6 +11,14 @@
 //! map array`, `communicate single vel yes`, `newton off`, `neigh_modify delay 0`,
 //! per-type material matrices that include wall types, `aveforce` per atom.
 //!
+//! A 3D scene's deck is the same deck in space: `boundary X f Z` (`p` along each periodic
+//! axis, x and z), the grains' three components of position, velocity and spin in
+//! grains.data, flat walls the same `yplane` primitives (infinite in x and z), rough walls
+//! the lattices of atoms the build glued over L_x by L_z, moved as one (`setforce`, nve,
+//! `aveforce`), and the records with the z components (series.txt: 12 columns per grain;
+//! walls.txt: each wall's z force). No `enforce2d` and no 2D dimension in either case:
+//! the plane's grains are spheres at z = 0 that nothing moves out of the plane.
+//!
 //! The scene name enters comments only, escaped (`comment`). What the deck cannot
 //! express is refused and what it expresses approximately is noted, both as
 //! [`super::fields`] says.
@@ -25,11 +33,12 @@ use crate::physics::contact::LeverArm;
 use crate::physics::material::{BetaRule, PairMaterial};
 use crate::physics::restitution::restitution_of_beta;
 use crate::engine::world::WallMotion;
+use crate::physics::dim::Dim;
 use crate::physics::walls::{Control, Surface};
 use crate::scene::{Analysis, NormalLaw, Scene, TangentialSpec};
 
 /// The deck of `code`, [`Code::Liggghts`] or [`Code::Lammps`].
-pub(crate) fn deck(scene: &Scene, ex: &Exported, code: Code) -> Result<String, Error> {
+pub(crate) fn deck<D: Dim>(scene: &Scene, ex: &Exported<D>, code: Code) -> Result<String, Error> {
     let lammps = code == Code::Lammps;
     let model = &scene.model;
     let e = ex.built.engine.as_ref();
@@ -51,7 +60,11 @@ pub(crate) fn deck(scene: &Scene, ex: &Exported, code: Code) -> Result<String, E
     } else {
         let _ = writeln!(w, "# Run in this directory: liggghts -in in.liggghts (reads grains.data, {writes}).");
     }
-    let _ = writeln!(w, "# Grains: spheres at z = 0 in a 3D box (the sphere-in-plane model); nothing moves them out of the plane.");
+    if D::D == 3 {
+        let _ = writeln!(w, "# Grains: spheres in space (a 3D scene): positions, velocities and spins of three components in grains.data.");
+    } else {
+        let _ = writeln!(w, "# Grains: spheres at z = 0 in a 3D box (the sphere-in-plane model); nothing moves them out of the plane.");
+    }
     let frictional = model.tangential != TangentialSpec::Frictionless;
     if lammps {
         // LAMMPS' arms are lever_arm lammps, and radius for one grain on flat walls; its
@@ -83,8 +96,11 @@ pub(crate) fn deck(scene: &Scene, ex: &Exported, code: Code) -> Result<String, E
     }
     let _ = writeln!(w, "{}\natom_modify map array", if lammps { "atom_style sphere" } else { "atom_style granular" });
     let px = if e.boundary().is_periodic() { "p" } else { "f" };
+    // Along z: periodic in a 3D scene with domain.periodic_z; else fixed bounds that hold
+    // every grain for the run (grains.data), as along x.
+    let pz = if e.boundary().is_periodic_z() { "p" } else { "f" };
     let comm = if lammps { "comm_modify vel yes" } else { "communicate single vel yes" };
-    let _ = writeln!(w, "boundary {px} f f\nnewton off\n{comm}\nunits si");
+    let _ = writeln!(w, "boundary {px} f {pz}\nnewton off\n{comm}\nunits si");
     let _ = writeln!(w, "read_data grains.data");
     let skin = scene.neighbor.skin * 2.0 * p.r[..p.n_free].iter().cloned().fold(f64::INFINITY, f64::min);
     let _ = writeln!(w, "neighbor {} bin\nneigh_modify delay 0", f(skin));
@@ -107,7 +123,7 @@ pub(crate) fn deck(scene: &Scene, ex: &Exported, code: Code) -> Result<String, E
         let name = wall.name;
         match &wall.surface {
             Surface::Flat => {
-                let shear = if wall.v.x != 0.0 { format!(" shear x {}", f(wall.v.x)) } else { String::new() };
+                let shear = if wall.v[0] != 0.0 { format!(" shear x {}", f(wall.v[0])) } else { String::new() };
                 if let Some(kinds) = &kinds {
                     // The bottom wall holds the grains above it (LO), the top one below (HI).
                     let plane = if wall.side > 0.0 { format!("yplane {} NULL{shear}", f(wall.y)) } else { format!("yplane NULL {}{shear}", f(wall.y)) };
@@ -131,7 +147,7 @@ pub(crate) fn deck(scene: &Scene, ex: &Exported, code: Code) -> Result<String, E
                 // The grains' force on the row: what `setforce` found before it set the
                 // row's (defined before `aveforce`, it sees the contacts' sum alone), a fix
                 // every control keeps, so one recording serves a protocol's stages.
-                wall_vars.push((name, format!("f_f_{name}[1]"), format!("f_f_{name}[2]"), a));
+                wall_vars.push((name, (1..=D::D).map(|k| format!("f_f_{name}[{k}]")).collect(), a));
                 let _ = writeln!(w, "fix i_{name} {name} nve");
             }
         }
@@ -150,6 +166,25 @@ pub(crate) fn deck(scene: &Scene, ex: &Exported, code: Code) -> Result<String, E
         return Ok(s);
     }
     match record {
+        Analysis::Impact if D::D == 3 => {
+            // Three components of each (common::impact_columns_in). LAMMPS has no per-atom
+            // spin in variables: a compute per component reads it.
+            if lammps {
+                for a in ["x", "y", "z"] {
+                    let _ = writeln!(w, "compute spin{a} all property/atom omega{a}");
+                }
+            }
+            let spin = |a: &'static str| if lammps { format!("c_spin{a}") } else { format!("omega{a}") };
+            let mut cols = vec!["${s}".to_string()];
+            for k in 1..=p.n_free {
+                let qs = [("x", "x".into()), ("y", "y".into()), ("z", "z".into()), ("vx", "vx".into()), ("vy", "vy".into()), ("vz", "vz".into()), ("wx", spin("x")), ("wy", spin("y")), ("wz", spin("z")), ("fx", "fx".into()), ("fy", "fy".into()), ("fz", "fz".into())];
+                for (q, v) in qs {
+                    let _ = writeln!(w, "variable {q}{k} equal {v}[{k}]");
+                    cols.push(format!("${{{q}{k}}}"));
+                }
+            }
+            let _ = writeln!(w, "fix rec all print 1 \"{}\" file series.txt screen no title \"{}\"", cols.join(" "), info.columns.join(" "));
+        }
         Analysis::Impact => {
             // LAMMPS has no per-atom spin in variables: a compute reads it.
             if lammps {
@@ -176,7 +211,7 @@ pub(crate) fn deck(scene: &Scene, ex: &Exported, code: Code) -> Result<String, E
 
 /// LIGGGHTS' material fixes and pair style; returns the model words the pair style and
 /// the wall/gran fixes share (`model hertz tangential history ...`).
-fn materials(w: &mut String, scene: &Scene, ex: &Exported) -> Result<String, Error> {
+fn materials<D: Dim>(w: &mut String, scene: &Scene, ex: &Exported<D>) -> Result<String, Error> {
     let model = &scene.model;
     let e = ex.built.engine.as_ref();
     let p = e.particles();
@@ -251,10 +286,11 @@ fn materials(w: &mut String, scene: &Scene, ex: &Exported) -> Result<String, Err
 /// at the row's step (as grainlab's rows: forces averaged over the interval, the gap where
 /// the walls are at its end), printed to walls.txt under a title line of `columns`. `k = 1`
 /// prints every step's forces as they are (a protocol's raw series, averaged by the digest).
+/// Each wall's x and y forces, and in 3D its z force (common::wall_columns_in).
 fn record_walls(w: &mut String, k: u64, wall_vars: &[WallVars], columns: &[String]) {
     let (bot, top) = (&wall_vars[0], &wall_vars[1]);
-    let _ = writeln!(w, "variable gap equal y[{}]-y[{}]", top.3, bot.3);
-    let forces = [&bot.1, &bot.2, &top.1, &top.2];
+    let _ = writeln!(w, "variable gap equal y[{}]-y[{}]", top.2, bot.2);
+    let forces: Vec<&String> = bot.1.iter().chain(&top.1).collect();
     if k > 1 {
         let _ = writeln!(w, "fix avg all ave/time 1 {k} {k} {}", forces.iter().map(|s| s.as_str()).collect::<Vec<_>>().join(" "));
     }
@@ -268,9 +304,9 @@ fn record_walls(w: &mut String, k: u64, wall_vars: &[WallVars], columns: &[Strin
     let _ = writeln!(w, "fix rec all print {k} \"{}\" file walls.txt screen no title \"{}\"", cols.join(" "), columns.join(" "));
 }
 
-/// A wall's recorded quantities: its name, the fix outputs of its x and y force, and its
-/// first atom's id.
-type WallVars = (&'static str, String, String, usize);
+/// A wall's recorded quantities: its name, the fix outputs of its force's components (x,
+/// y, and z in 3D), and its first atom's id.
+type WallVars = (&'static str, Vec<String>, usize);
 
 /// A protocol's stages, each a `run` block, and one recording for all of them: every
 /// step's wall forces and gap (walls.txt holds every step; the digest averages it into
@@ -283,7 +319,7 @@ type WallVars = (&'static str, String, String, usize);
 /// setup: that stage's first step then differs, and the deck says so (a `# Differs:` line
 /// at its top, `header`). What a flat wall would need (its motion and history live in its
 /// wall/gran fix) and gravity are refused by name.
-fn stages(w: &mut String, header: &mut String, scene: &Scene, ex: &Exported, code: Code, record: Analysis, wall_vars: &[WallVars]) -> Result<(), Error> {
+fn stages<D: Dim>(w: &mut String, header: &mut String, scene: &Scene, ex: &Exported<D>, code: Code, record: Analysis, wall_vars: &[WallVars]) -> Result<(), Error> {
     let e = ex.built.engine.as_ref();
     let p = e.particles();
     let info = &ex.info;
@@ -343,7 +379,7 @@ fn stages(w: &mut String, header: &mut String, scene: &Scene, ex: &Exported, cod
 /// The load `force` (N) on a rough `wall`'s row of `grains`: `aveforce` adds its share to
 /// each atom. The row moves as its atoms, so its mass must be theirs (equal atoms, so
 /// aveforce's equal forces keep it rigid): another is refused by name.
-fn load_row(w: &mut String, code: Code, wall: &crate::physics::walls::Wall, grains: &std::ops::Range<usize>, p: &crate::physics::particles::Particles, force: f64) -> Result<(), Error> {
+fn load_row<D: Dim>(w: &mut String, code: Code, wall: &crate::physics::walls::Wall<D>, grains: &std::ops::Range<usize>, p: &crate::physics::particles::Particles<D>, force: f64) -> Result<(), Error> {
     let name = wall.name;
     let atoms: f64 = grains.clone().map(|k| p.m[k]).sum();
     if (wall.mass - atoms).abs() > 1e-12 * atoms {
@@ -378,7 +414,7 @@ pub(crate) fn name_of<T: serde::Serialize>(v: &T) -> String {
 /// when every contact the pair can make has one reduced mass m*. The (gamma_n, gamma_t)
 /// of each pair of types (materials), row by row; a pair that meets at two reduced masses
 /// is refused naming `model.normal.hooke_stiffness.kn` (and kt).
-fn spring_rates(scene: &Scene, p: &crate::physics::particles::Particles, walls: &[crate::physics::walls::Wall], kn: f64, kt: f64) -> Result<Vec<(f64, f64)>, Error> {
+fn spring_rates<D: Dim>(scene: &Scene, p: &crate::physics::particles::Particles<D>, walls: &[crate::physics::walls::Wall<D>], kn: f64, kt: f64) -> Result<Vec<(f64, f64)>, Error> {
     let n = scene.materials.len();
     // The reduced masses each pair of types meets at: grain pairs, and grains on flat
     // walls (m* = m), whose wall/gran fixes share the pair style's table.

@@ -31,10 +31,12 @@ pub mod yade;
 
 use std::path::Path;
 
-pub use common::{Code, ExportInfo, escaped, impact_columns, wall_columns};
+pub use common::{Code, ExportInfo, escaped, impact_columns, impact_columns_in, wall_columns, wall_columns_in};
 
+use crate::engine::build::Building;
 use crate::error::Error;
-use crate::scene::Scene;
+use crate::physics::dim::{Plane, Space};
+use crate::scene::{Dimension, Scene};
 use prepare::{bounds, grains_data, prepare};
 
 /// Write the deck for `code`, the shared particle file and export.json into `dir`.
@@ -57,9 +59,22 @@ pub fn export_with(scene: &Scene, code: Code, dir: &Path, bench: bool) -> Result
     Ok(written)
 }
 
-/// What [`export_with`] writes, as (file name, text), without writing it.
+/// What [`export_with`] writes, as (file name, text), without writing it: a 2D scene's
+/// decks (spheres in the plane z = 0) or a 3D scene's (spheres in space).
 pub fn export_files(scene: &Scene, code: Code, bench: bool, limits: &crate::scene::limits::Limits) -> Result<Vec<(&'static str, String)>, Error> {
-    let mut ex = prepare(scene, code, limits)?;
+    match scene.dimension {
+        Dimension::Two => files_in::<Plane>(scene, code, bench, limits),
+        Dimension::Three => files_in::<Space>(scene, code, bench, limits),
+    }
+}
+
+/// [`export_files`] of a scene built in `D`.
+fn files_in<D: Building>(scene: &Scene, code: Code, bench: bool, limits: &crate::scene::limits::Limits) -> Result<Vec<(&'static str, String)>, Error>
+where
+    D::Vector<f64>: serde::Serialize + serde::de::DeserializeOwned,
+    D::Spin<f64>: serde::Serialize + serde::de::DeserializeOwned,
+{
+    let mut ex = prepare::<D>(scene, code, limits)?;
     if scene.model.tangential == crate::scene::TangentialSpec::MindlinDeresiewicz {
         return Err(fields::refuse(code, "model.tangential", "\"mindlin_deresiewicz\"", ""));
     }

@@ -12,6 +12,14 @@
 //! the contact point), the values solved from grainlab's pairs or refused by name
 //! ([`spring_materials`]).
 //!
+//! A 3D scene's script is the same script in space: the free spheres unblocked (no
+//! `blockedDOFs = 'zXY'`; without rotation `'XYZ'`), their three components of velocity
+//! and spin from grains.data, flat walls the same `wall` bodies (infinite in x and z),
+//! rough walls the lattices of spheres the build glued over L_x by L_z (blocked, the
+//! loaded one a clump), the periodic cell periodic in z too when the scene is (else made
+//! 10x the packing along z, as along y), and the records with the z components
+//! (series.txt: 12 columns per grain; walls.txt: each wall's z force).
+//!
 //! The scene name enters comments only, escaped ([`super::escaped`]). What the script
 //! cannot express is refused and what it expresses approximately is noted, both as
 //! [`super::fields`] says.
@@ -24,11 +32,13 @@ use super::common::{Code, contact_kinds, escaped, f, same_value};
 use super::prepare::{Exported, pressure};
 use crate::error::Error;
 use crate::physics::contact::LeverArm;
+use crate::physics::dim::Dim;
 use crate::physics::material::PairMaterial;
 use crate::physics::walls::{Control, Surface};
 use crate::scene::{Analysis, Scene, TangentialSpec};
 
-pub(crate) fn deck(scene: &Scene, ex: &Exported) -> Result<String, Error> {
+pub(crate) fn deck<D: Dim>(scene: &Scene, ex: &Exported<D>) -> Result<String, Error> {
+    let space = D::D == 3;
     let model = &scene.model;
     let mats = &scene.materials;
     // The linear spring: ViscElMat and its law; Hertz: FrictMat and Mindlin's law, with
@@ -61,6 +71,10 @@ pub(crate) fn deck(scene: &Scene, ex: &Exported) -> Result<String, Error> {
     } else if let Some(w) = loaded {
         return Err(refuse(Code::Yade, &format!("walls.{}.control.pressure", w.name), pressure(scene, w.name), "no domain.periodic_x"));
     }
+    // A periodic z (3D) has the periodic shear cell's script only.
+    if let (Some([a, b]), false) = (scene.domain.periodic_z, periodic) {
+        return Err(refuse(Code::Yade, "domain.periodic_z", format!("[{a}, {b}]"), "no domain.periodic_x"));
+    }
     let mut s = String::new();
     let w = &mut s;
     let _ = writeln!(w, "# YADE 2023.02a script exported by grainlab {} from scene `{}`. Generated: do not edit;", env!("CARGO_PKG_VERSION"), escaped(&scene.name, &[]));
@@ -83,7 +97,7 @@ pub(crate) fn deck(scene: &Scene, ex: &Exported) -> Result<String, Error> {
     // starts apart from velocity Verlet's run.
     if let Some(wall) = loaded {
         let _ = writeln!(w, "{}", differs_line(Code::Yade, &format!("walls.{}.control.pressure", wall.name), pressure(scene, wall.name)));
-    } else if (0..p.n_free).any(|i| p.f[i] != crate::physics::dim::Vec2::zeros()) {
+    } else if (0..p.n_free).any(|i| (0..D::D).any(|k| p.f[i][k] != 0.0)) {
         let _ = writeln!(w, "# Differs: grains under a force at t = 0: {}", note(Code::Yade, "walls.top.control.pressure"));
     }
     let _ = writeln!(w, "import math, sys");
@@ -111,16 +125,20 @@ pub(crate) fn deck(scene: &Scene, ex: &Exported) -> Result<String, Error> {
     let _ = writeln!(w, "DT = {}\nSTEPS = {}", f(info.time_step_s), info.steps);
     let record = !ex.bench && info.analysis != Analysis::None;
     let _ = writeln!(w, "RECORD = {}  # False in a timing deck", if record { "True" } else { "False" });
+    // In space the spheres are free and read with their three components.
+    let common = if space { edited(COMMON, GRAINS_PLANE, GRAINS_SPACE) } else { COMMON.to_string() };
     if spring.is_some() {
-        let common = edited(COMMON, MATS_HERTZ, MATS_SPRING);
+        let common = edited(&common, MATS_HERTZ, MATS_SPRING);
         let _ = writeln!(w, "{}", edited(&common, LAW_HERTZ, LAW_SPRING));
     } else {
-        let _ = writeln!(w, "{}", COMMON);
+        let _ = writeln!(w, "{}", common);
     }
     // Without rotation (and with friction: frictionless grains never spin) the free
     // grains' spin is blocked too.
     let no_spin = if model.rotation || frictionless {
         ""
+    } else if space {
+        "for i in ids:\n    O.bodies[i].state.blockedDOFs = 'XYZ'  # model.rotation = false: the free grains do not spin"
     } else {
         "for i in ids:\n    O.bodies[i].state.blockedDOFs = 'zXYZ'  # model.rotation = false: the free grains do not spin"
     };
@@ -131,19 +149,38 @@ pub(crate) fn deck(scene: &Scene, ex: &Exported) -> Result<String, Error> {
             let [x0, x1] = scene.domain.periodic_x.expect("periodic");
             return Err(refuse(Code::Yade, "domain.periodic_x", format!("[{x0}, {x1}]"), &format!("a cell of {:e} m, under 4 r_max + 2 r_min = {:e} m", b.period, 4.0 * r_max + 2.0 * r_min)));
         }
+        if b.is_periodic_z() && b.z_period < 4.0 * r_max + 2.0 * r_min {
+            let [z0, z1] = scene.domain.periodic_z.expect("periodic in z");
+            return Err(refuse(Code::Yade, "domain.periodic_z", format!("[{z0}, {z1}]"), &format!("a cell of {:e} m along z, under 4 r_max + 2 r_min = {:e} m", b.z_period, 4.0 * r_max + 2.0 * r_min)));
+        }
         let range = |k: usize| match &walls[k].surface {
             Surface::Rough { grains } => Ok((grains.start, grains.end)),
             Surface::Flat => Err(Error::Export("export to yade: the shear export needs rough walls".into())),
         };
         let ((b0, b1), (t0, t1)) = (range(0)?, range(1)?);
-        let ys = p.x.iter().map(|x| x.y);
+        let ys = p.x.iter().map(|x| x[1]);
         let (lo, hi) = ys.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, c), y| (a.min(y), c.max(y)));
         let load = match walls[1].control {
             Control::Load { force } => force,
             Control::Fixed => 0.0,
         };
-        let _ = writeln!(w, "# Periodic in x; YADE cells are periodic in every direction, so y and z are made 10x the packing.");
-        let _ = writeln!(w, "X0 = {}\nL = {}\nH = {}", f(b.x_min), f(b.period), f(10.0 * (hi - lo)));
+        if space {
+            // The cell along z: the scene's periodic one, or (free grains along z) 10x the
+            // grains' z extent (at least H), centred on them: nothing crosses it in a run.
+            let (z0, lz) = if b.is_periodic_z() {
+                let _ = writeln!(w, "# Periodic in x and z; YADE cells are periodic in every direction, so y is made 10x the packing.");
+                (b.z_min, b.z_period)
+            } else {
+                let _ = writeln!(w, "# Periodic in x; YADE cells are periodic in every direction, so y and z are made 10x the packing.");
+                let (zlo, zhi) = p.x.iter().map(|x| x[2]).fold((f64::INFINITY, f64::NEG_INFINITY), |(a, c), z| (a.min(z), c.max(z)));
+                let lz = (10.0 * (zhi - zlo)).max(10.0 * (hi - lo));
+                (0.5 * (zlo + zhi) - 0.5 * lz, lz)
+            };
+            let _ = writeln!(w, "X0 = {}\nL = {}\nH = {}\nZ0 = {}\nLZ = {}", f(b.x_min), f(b.period), f(10.0 * (hi - lo)), f(z0), f(lz));
+        } else {
+            let _ = writeln!(w, "# Periodic in x; YADE cells are periodic in every direction, so y and z are made 10x the packing.");
+            let _ = writeln!(w, "X0 = {}\nL = {}\nH = {}", f(b.x_min), f(b.period), f(10.0 * (hi - lo)));
+        }
         let _ = writeln!(w, "FREE = {}\nBOTTOM = ({b0}, {b1})\nTOP = ({t0}, {t1})", p.n_free);
         let _ = writeln!(w, "LOAD = {}  # N on the top wall, towards the grains (0: the wall is held)", f(load));
         if scene.stages.is_empty() {
@@ -151,7 +188,7 @@ pub(crate) fn deck(scene: &Scene, ex: &Exported) -> Result<String, Error> {
         } else {
             let _ = writeln!(w, "SAMPLE = 1  # a protocol's walls.txt: a row at every step");
         }
-        let _ = writeln!(w, "{}", SHEAR_FREE);
+        let _ = writeln!(w, "{}", if space { edited(&edited(SHEAR_FREE, "O.cell.setBox(L, H, H)", "O.cell.setBox(L, H, LZ)"), "Vector3(-X0, 0.5 * H, 0)  # into the cell [0, L) x [0, H)", "Vector3(-X0, 0.5 * H, -Z0)  # into the cell [0, L) x [0, H) x [0, LZ)") } else { SHEAR_FREE.to_string() });
         if !no_spin.is_empty() {
             let _ = writeln!(w, "{no_spin}");
         }
@@ -163,10 +200,11 @@ pub(crate) fn deck(scene: &Scene, ex: &Exported) -> Result<String, Error> {
         if (load > 0.0 || loaded_later) && given.is_some() {
             let _ = writeln!(w, "c.mass = {}  # walls.top.mass, kg", f(walls[1].mass));
         }
+        let run = shear_run::<D>(&info.columns);
         if scene.stages.is_empty() {
-            let _ = writeln!(w, "{}", SHEAR_RUN);
+            let _ = writeln!(w, "{}", run);
         } else {
-            let _ = writeln!(w, "{}", stages(scene, ex)?);
+            let _ = writeln!(w, "{}", stages(scene, ex, &run)?);
         }
         return Ok(s);
     }
@@ -187,8 +225,15 @@ pub(crate) fn deck(scene: &Scene, ex: &Exported) -> Result<String, Error> {
         if let Surface::Flat = wall.surface {
             let material = if spring.is_some() { format!("wmats[{j}]") } else { format!("mats[{}]", wall.material) };
             let _ = writeln!(w, "b = O.bodies.append(wall({}, axis=1, sense={}, material={material}))", f(wall.y), if wall.side > 0.0 { 1 } else { -1 });
-            let _ = writeln!(w, "O.bodies[b].state.vel = Vector3({}, 0, 0)", f(wall.v.x));
+            let _ = writeln!(w, "O.bodies[b].state.vel = Vector3({}, 0, 0)", f(wall.v[0]));
         }
+    }
+    if space {
+        let cols = super::common::IMPACT_SPACE.map(|q| format!("'{q}'")).join(", ");
+        let impact = edited(IMPACT, "('x_m', 'y_m', 'vx_m_s', 'vy_m_s', 'omega_rad_s', 'fx_n', 'fy_n')", &format!("({cols})"));
+        let impact = edited(&impact, "(st.pos[0], st.pos[1], st.vel[0], st.vel[1], st.angVel[2], fo[0], fo[1])", "(st.pos[0], st.pos[1], st.pos[2], st.vel[0], st.vel[1], st.vel[2], st.angVel[0], st.angVel[1], st.angVel[2], fo[0], fo[1], fo[2])");
+        let _ = writeln!(w, "{impact}");
+        return Ok(s);
     }
     let _ = writeln!(w, "{}", IMPACT);
     Ok(s)
@@ -208,6 +253,18 @@ wmats = [O.materials.append(ViscElMat(kn=WALL_KN[j], ks=WALL_KS[j], cn=WALL_CN[j
 /// The contact law of the Hertz deck's [`COMMON`], and the linear spring's in its place.
 const LAW_HERTZ: &str = "        [Ip2_FrictMat_FrictMat_MindlinPhys(betan=BETA, betas=BETA)],\n        [Law2_ScGeom_MindlinPhys_Mindlin()],\n";
 const LAW_SPRING: &str = "        [Ip2_ViscElMat_ViscElMat_ViscElPhys()],\n        [Law2_ScGeom_ViscElPhys_Basic()],\n";
+
+/// How [`COMMON`]'s `grains()` reads a sphere in the plane (z motion and the spins about
+/// x and y blocked, the spin about z), and in space in its place (free, all components).
+const GRAINS_PLANE: &str = "        b.state.blockedDOFs = 'zXY'
+        _, vx, vy, vz, wx, wy, wz = lines[vels + k]
+        b.state.vel = Vector3(float(vx), float(vy), 0.0)
+        b.state.angVel = Vector3(0.0, 0.0, float(wz))
+";
+const GRAINS_SPACE: &str = "        _, vx, vy, vz, wx, wy, wz = lines[vels + k]
+        b.state.vel = Vector3(float(vx), float(vy), float(vz))
+        b.state.angVel = Vector3(float(wx), float(wy), float(wz))
+";
 
 const COMMON: &str = r#"mats = [O.materials.append(FrictMat(young=E[k], poisson=NU[k], density=RHO[k], frictionAngle=math.atan(MU[k]))) for k in range(len(E))]
 def grains():
@@ -250,7 +307,7 @@ O.dt = DT"#;
 /// new velocities would enter the contact forces of the stage's first state, one step
 /// early.) The run goes one iteration past the protocol: its PyRunner records the forces
 /// of the last step's state.
-fn stages(scene: &Scene, ex: &Exported) -> Result<String, Error> {
+fn stages<D: Dim>(scene: &Scene, ex: &Exported<D>, shear_run: &str) -> Result<String, Error> {
     let info = &ex.info;
     let phases = crate::study::protocol::phases(scene, info.time_step_s, info.length_m, info.depth_m)?;
     let mut rows = Vec::new();
@@ -269,8 +326,8 @@ fn stages(scene: &Scene, ex: &Exported) -> Result<String, Error> {
     // The plain run's script, its record() ending with the stage changes and its O.run
     // replaced by the stages' (each piece found once: a template edited out of step with
     // this fails every protocol export's test, not silently).
-    let reset = "        for k in range(4):\n            acc[k] = 0.0\n";
-    let run = edited(SHEAR_RUN, reset, &format!("{reset}    while NEXT[0] < len(STAGES) and STAGES[NEXT[0]][1] == O.iter:\n        begin(STAGES[NEXT[0]])\n"));
+    let reset = if D::D == 3 { "        for k in range(6):\n            acc[k] = 0.0\n" } else { "        for k in range(4):\n            acc[k] = 0.0\n" };
+    let run = edited(shear_run, reset, &format!("{reset}    while NEXT[0] < len(STAGES) and STAGES[NEXT[0]][1] == O.iter:\n        begin(STAGES[NEXT[0]])\n"));
     let run = edited(
         &run,
         "O.run(STEPS, True)\n",
@@ -327,6 +384,18 @@ c.angVel = Vector3(0, 0, 0)
 c.blockedDOFs = 'xzXYZ' if LOAD > 0 else 'xyzXYZ'
 if LOAD > 0:
     O.forces.setPermF(top_clump, Vector3(0, -LOAD, 0))"#;
+
+/// The shear cell's run in `D`: [`SHEAR_RUN`] in the plane; in space its walls.txt has
+/// the walls' z forces too, under the title line of `columns` (common::wall_columns_in).
+fn shear_run<D: Dim>(columns: &[String]) -> String {
+    if D::D == 2 {
+        return SHEAR_RUN.to_string();
+    }
+    let run = edited(SHEAR_RUN, "out.write('step bottom_fx_n bottom_fy_n top_fx_n top_fy_n gap_m\\n')", &format!("out.write('{}\\n')", columns.join(" ")));
+    let run = edited(&run, "acc = [0.0] * 4", "acc = [0.0] * 6");
+    let run = edited(&run, "enumerate((fb[0], fb[1], ft[0], ft[1]))", "enumerate((fb[0], fb[1], fb[2], ft[0], ft[1], ft[2]))");
+    edited(&run, "        for k in range(4):\n", "        for k in range(6):\n")
+}
 
 const SHEAR_RUN: &str = r#"out = open('walls.txt', 'w')
 out.write('step bottom_fx_n bottom_fy_n top_fx_n top_fy_n gap_m\n')
@@ -410,7 +479,7 @@ fn series_partner(target: f64, known: f64) -> Option<f64> {
     }
 }
 
-fn spring_materials(scene: &Scene, ex: &Exported) -> Result<SpringMaterials, Error> {
+fn spring_materials<D: Dim>(scene: &Scene, ex: &Exported<D>) -> Result<SpringMaterials, Error> {
     use crate::physics::contact::damping::{Damping, LinearRestitution};
     let e = ex.built.engine.as_ref();
     let mats = &scene.materials;
@@ -511,7 +580,7 @@ mod tests {
     }
 
     fn spring(scene: &Scene) -> Result<SpringMaterials, Error> {
-        let ex = super::super::prepare::prepare(scene, Code::Yade, &crate::scene::limits::Limits::machine())?;
+        let ex = super::super::prepare::prepare::<crate::physics::dim::Plane>(scene, Code::Yade, &crate::scene::limits::Limits::machine())?;
         spring_materials(scene, &ex)
     }
 
@@ -527,7 +596,7 @@ mod tests {
         }
         let sm = spring(&s).unwrap();
         let pm = PairMaterial::mix(&s.materials[0], &s.materials[1]);
-        let ex = super::super::prepare::prepare(&s, Code::Yade, &crate::scene::limits::Limits::machine()).unwrap();
+        let ex = super::super::prepare::prepare::<crate::physics::dim::Plane>(&s, Code::Yade, &crate::scene::limits::Limits::machine()).unwrap();
         let p = ex.built.engine.particles();
         let (m, r) = (crate::physics::material::reduced(p.m[0], p.m[1]), crate::physics::material::reduced(p.r[0], p.r[1]));
         let kn = s.model.normal.stiffness(&pm, r, m, 0.0).kn;
