@@ -213,21 +213,6 @@ fn impact_of(scene: &Scene) -> grainlab::ImpactSummary {
     s.impact.unwrap_or_else(|| panic!("{}: no impact measured ({:?})", scene.name, s.impact_note))
 }
 
-/// `scene` (a plane impact) in space, turned by `rot`: positions, velocities and spins
-/// (about z in the plane, about `rot z` in space) turned.
-fn turned(scene: &Scene, rot: &nalgebra::Rotation3<f64>) -> Scene {
-    let mut s = scene.clone();
-    s.dimension = Dimension::Three;
-    let Grains::List(list) = &mut s.grains else { panic!("an impact lists its grains") };
-    for g in list.iter_mut() {
-        let x = rot * nalgebra::Vector3::new(g.x[0], g.x[1], 0.0);
-        let v = rot * nalgebra::Vector3::new(g.v[0], g.v[1], 0.0);
-        let w = rot * nalgebra::Vector3::new(0.0, 0.0, g.omega.z());
-        (g.x, g.v, g.omega) = ([x.x, x.y, x.z].into(), [v.x, v.y, v.z].into(), grainlab::scene::SpinSpec::Vector([w.x, w.y, w.z]));
-    }
-    s
-}
-
 /// The impact observer in space measures an impact in its own plane: a plane impact
 /// turned out of the x-y plane gives the plane's summary. The built-in 3D head-on impact
 /// (along the skew line (2, 1, 2)/3) and oblique impact on a wall (its tangential
@@ -245,14 +230,13 @@ fn impacts_turned_out_of_the_plane_measure_as_in_the_plane() {
     if let Grains::List(list) = &mut pair.grains {
         list[0].omega = 150.0.into();
     }
-    let skew = nalgebra::Rotation3::from_axis_angle(&nalgebra::Unit::new_normalize(nalgebra::Vector3::new(1.0, 2.0, 3.0)), 0.7);
     let mut lifted_pair = pair.clone();
     lifted_pair.dimension = Dimension::Three;
     let builtin = |n: &str| grainlab::scene::builtin::builtin(n).unwrap();
     let cases = [
         ("collision3d", builtin("collision"), builtin("collision3d")),
         ("oblique3d", builtin("oblique"), builtin("oblique3d")),
-        ("turned spinning pair", pair.clone(), turned(&pair, &skew)),
+        ("turned spinning pair", pair.clone(), grainlab::scene::builtin::turned(&pair, [1.0, 2.0, 3.0], 0.7)),
         ("lifted spinning pair", pair.clone(), lifted_pair),
     ];
     for (name, a, b) in cases {

@@ -226,6 +226,23 @@ pub fn oblique_space(material: Material, r: f64, v: f64, angle_deg: f64, tangent
     s
 }
 
+/// A plane impact `scene` in space, turned by `angle` (rad) about the unit `axis`: its
+/// grains' positions, velocities and spins (about z in the plane, about the turned z in
+/// space). A scene with walls may be turned only about y (walls are normal to y).
+pub fn turned(scene: &Scene, axis: [f64; 3], angle: f64) -> Scene {
+    let rot = nalgebra::Rotation3::from_axis_angle(&nalgebra::Unit::new_normalize(nalgebra::Vector3::from(axis)), angle);
+    let mut s = scene.clone();
+    s.dimension = Dimension::Three;
+    if let Grains::List(list) = &mut s.grains {
+        for g in list.iter_mut() {
+            use crate::physics::dim::Space;
+            let (x, v, w) = (rot * g.x.lift::<Space>(), rot * g.v.lift::<Space>(), rot * g.omega.lift::<Space>());
+            (g.x, g.v, g.omega) = (<[f64; 3]>::from(x).into(), <[f64; 3]>::from(v).into(), SpinSpec::Vector(w.into()));
+        }
+    }
+    s
+}
+
 /// The shear cell in a four-stage protocol: the packing is compressed under 100 kPa with
 /// the walls at rest, relaxes under the load, is sheared with the walls at +-0.5 m/s and
 /// then at +-2 m/s. The time step is set for contacts at 2 m/s, the fastest stage's

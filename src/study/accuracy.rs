@@ -43,7 +43,7 @@ pub fn error(q: AccuracyQuantity, a: &ImpactSummary, b: &ImpactSummary) -> f64 {
 /// the impact's summary and its force-overlap curve. The same steps and the same bits as
 /// [`crate::study::run::run_scene`] on the scene, without its outputs; the calibration's
 /// head-on impacts are run this way, each an engine of its own.
-pub fn step_impact(built: &mut Built, scene: &Scene) -> Result<ImpactObserver, Error> {
+pub fn step_impact<D: crate::observe::impact::Impacts>(built: &mut Built<D>, scene: &Scene) -> Result<ImpactObserver<D>, Error> {
     let e = built.engine.as_mut();
     let (total, _) = crate::engine::timestep::schedule(scene.duration, e.dt(), scene.output.samples);
     let mut obs = ImpactObserver::default();

@@ -104,6 +104,7 @@ pub fn cases() -> Vec<Case> {
         }
     }
     lammps_cases(&mut out);
+    space_cases(&mut out);
     linear_spring_cases(&mut out);
     chung_ooi_cases(&mut out);
     rolling_cases(&mut out);
@@ -154,6 +155,53 @@ pub fn cases() -> Vec<Case> {
         }
     }
     out
+}
+
+/// Angles of the oblique impacts in space, degrees from the normal.
+pub const SPACE_ANGLES: [f64; 3] = [15.0, 45.0, 75.0];
+
+/// The impacts in space (issue 30), each run natively in 3D by the codes: head-on
+/// impacts along the skew line (2, 1, 2)/3 (`space-restitution/`, with the clamp, by
+/// LIGGGHTS, YADE and LAMMPS as the plane's clamped grid); a glass bead on a flat wall
+/// with its tangential velocity along (3, 0, 4)/5, out of the x-y plane
+/// (`space-oblique-wall/`); a bead on a resting one in the plane turned 0.7 rad about
+/// (1, 2, 3) (`space-oblique-pair/`); and a bead spinning about two axes (x and z) hitting
+/// a wall at 45 degrees along x (`space-spin/`): the tangential formulations each with
+/// its code's settings ([`matched`]), LIGGGHTS' history and YADE's incremental force.
+fn space_cases(out: &mut Vec<Case>) {
+    for e in [0.1, 0.5, 0.9] {
+        for v in [0.1, 1.0] {
+            let mut s = builtin::head_on_space(glass(e), 1e-3, v, 50.0, [2.0 / 3.0, 1.0 / 3.0, 2.0 / 3.0]);
+            s.model.limit_force = true;
+            s.model.lever_arm = LeverArm::RadiusMinusHalfOverlap;
+            s.description = format!("head-on glass spheres r = 1 mm in space along (2, 1, 2)/3, e = {e}, v = {v} m/s, dt = t_c/50, Fn clamp on");
+            let name = format!("space-restitution/e{}-v{}", num(e), num(v));
+            out.push(Case::new(name, s, vec![Code::Liggghts, Code::Yade, Code::Lammps], v == 1.0).with_curve(v == 1.0 && e == 0.5));
+        }
+    }
+    let forms = [(TangentialSpec::TotalDisplacement, Code::Liggghts, "history"), (TangentialSpec::IncrementalForce, Code::Yade, "incremental")];
+    for &a in &SPACE_ANGLES {
+        for (form, code, tag) in forms {
+            let mut s = builtin::oblique_space(glass(0.9), 1e-3, 1.0, a, form, 200.0, [0.6, 0.8]);
+            matched(&mut s, form);
+            s.description = format!("glass sphere on a flat glass wall at 1 m/s, {a} deg from the normal, its tangential velocity along (3, 0, 4)/5, e = 0.9, mu = 0.5, t_c/200");
+            out.push(Case::new(format!("space-oblique-wall/{tag}-a{}", num(a)), s, vec![code], a == 45.0));
+            let mut s = builtin::turned(&oblique_pair(a, form), [1.0, 2.0, 3.0], 0.7);
+            s.description = format!("glass sphere on a resting one at 1 m/s, {a} deg from the line of centres, in the plane turned 0.7 rad about (1, 2, 3), e = 0.9, mu = 0.5, t_c/200");
+            out.push(Case::new(format!("space-oblique-pair/{tag}-a{}", num(a)), s, vec![code], a == 45.0));
+        }
+    }
+    for w in [[300.0, -500.0], [-600.0, 200.0]] {
+        for (form, code, tag) in forms {
+            let mut s = builtin::oblique_space(glass(0.9), 1e-3, 1.0, 45.0, form, 200.0, [1.0, 0.0]);
+            if let crate::scene::Grains::List(g) = &mut s.grains {
+                g[0].omega = crate::scene::SpinSpec::Vector([w[0], 0.0, w[1]]);
+            }
+            matched(&mut s, form);
+            s.description = format!("glass sphere spinning at ({}, 0, {}) rad/s hitting a flat glass wall at 1 m/s, 45 deg from the normal along x, e = 0.9, mu = 0.5, t_c/200", w[0], w[1]);
+            out.push(Case::new(format!("space-spin/{tag}-wx{}-wz{}", num(w[0]), num(w[1])), s, vec![code], w[0] == 300.0));
+        }
+    }
 }
 
 /// The linear spring's stiffnesses in the `hooke-*` cases that give them (LIGGGHTS

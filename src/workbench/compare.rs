@@ -199,7 +199,7 @@ pub fn compare_case(case_dir: &Path) -> Result<Vec<Row>, Error> {
                 (engine_impact(&scene)?, None)
             };
             // Tangential outcomes too where the impact has a tangential part.
-            let oblique = case.name.contains("oblique") || case.name.starts_with("chung-ooi") || case.name.starts_with("rolling/");
+            let oblique = case.name.contains("oblique") || case.name.starts_with("chung-ooi") || case.name.starts_with("rolling/") || case.name.starts_with("space-spin/");
             for code in codes {
                 rows.extend(compare_impact(&case.name, code, &e, &expected_impact(case_dir, code)?, oblique));
                 // The force-overlap curve on a common normalised grid (50 overlaps per
@@ -398,10 +398,15 @@ pub fn compare_steps(case: &str, code: Code, info: &ExportInfo, load: Option<f64
 
 /// The engine's impact summary and force-overlap curve for a scene.
 pub fn engine_impact_curve(scene: &Scene) -> Result<(ImpactSummary, Vec<CurvePoint>), Error> {
-    let mut built = crate::study::build(scene)?;
-    let obs = crate::study::accuracy::step_impact(&mut built, scene)?;
-    let s = obs.summary().ok_or_else(|| Error::Other(format!("{}: no impact", scene.name)))?;
-    Ok((s, obs.curve))
+    fn stepped<D: crate::observe::impact::Impacts>(mut built: crate::engine::build::Built<D>, scene: &Scene) -> Result<(ImpactSummary, Vec<CurvePoint>), Error> {
+        let obs = crate::study::accuracy::step_impact(&mut built, scene)?;
+        let s = obs.summary().ok_or_else(|| Error::Other(format!("{}: no impact", scene.name)))?;
+        Ok((s, obs.curve))
+    }
+    match scene.dimension {
+        crate::scene::Dimension::Two => stepped(crate::study::build(scene)?, scene),
+        crate::scene::Dimension::Three => stepped(crate::study::build_in::<crate::physics::dim::Space>(scene, 1, &crate::scene::limits::Limits::machine())?, scene),
+    }
 }
 
 /// Largest difference of two force-overlap curves on a common normalised grid: overlap

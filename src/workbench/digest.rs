@@ -5,11 +5,13 @@
 use std::path::{Path, PathBuf};
 
 use crate::error::Error;
-use crate::observe::impact::{ImpactObserver, ImpactState, ImpactSummary};
+use crate::observe::impact::{CurvePoint, ImpactObserver, ImpactState, ImpactSummary, Impacts};
 use crate::observe::stress::{WallRow, stress_estimates};
 use crate::output::csv::CsvSeries;
 use crate::physics::boundary::Boundary;
-use crate::physics::dim::Vec2;
+use crate::physics::dim::{Plane, Space, Vec2};
+
+type Vec3 = nalgebra::Vector3<f64>;
 use crate::scene::Analysis;
 use crate::workbench::cases::read_info;
 use crate::workbench::export::{Code, ExportInfo};
@@ -39,17 +41,20 @@ pub fn digest(case_dir: &Path, code: Code, run_dir: &Path) -> Result<PathBuf, Er
     std::fs::create_dir_all(&out).map_err(|e| Error::io(out.display(), e))?;
     match info.analysis {
         Analysis::Impact => {
-            let (obs, summary) = impact_of_series(&info, &run_dir.join("series.txt"))?;
+            let (curve, summary) = impact_of_series(&info, &run_dir.join("series.txt"))?;
             CsvSeries::create(&out.join("impact.csv"))?.row(&summary)?;
             if case.curve {
                 let mut w = CsvSeries::create(&out.join("force_overlap.csv"))?;
-                for p in &obs.curve {
+                for p in &curve {
                     w.row(p)?;
                 }
             }
         }
         Analysis::Shear => {
             let (_, rows) = read_table(&run_dir.join("walls.txt"))?;
+            // In space the rows carry the walls' z forces too (wall_columns_in); the
+            // stresses are of the x and y forces, as grainlab's walls.csv.
+            let rows: Vec<Vec<f64>> = if info.dimension.is_two() { rows } else { rows.iter().map(|r| [0, 1, 2, 4, 5, 7].map(|k| r[k]).to_vec()).collect() };
             let series = if info.stages.is_empty() {
                 rows.iter().map(|r| WallRow::new(r[0] * info.time_step_s, Vec2::new(r[1], r[2]), Vec2::new(r[3], r[4]), r[5], info.length_m, info.depth_m)).collect()
             } else {
@@ -111,22 +116,43 @@ fn protocol_rows(info: &ExportInfo, rows: &[Vec<f64>]) -> Result<Vec<WallRow>, S
     Ok(out)
 }
 
-/// Run the impact observer over a series.txt.
-pub fn impact_of_series(info: &ExportInfo, path: &Path) -> Result<(ImpactObserver, ImpactSummary), Error> {
+/// Run the impact observer over a series.txt: the force-overlap curve and the summary.
+pub fn impact_of_series(info: &ExportInfo, path: &Path) -> Result<(Vec<CurvePoint>, ImpactSummary), Error> {
     let (header, rows) = read_table(path)?;
     if header != info.columns {
         return Err(Error::Other(format!("{}: columns {:?}, expected {:?}", path.display(), header, info.columns)));
     }
     let two = info.radii_m.len() == 2;
     let j = if two { 1 } else { 0 };
+    let m = &info.masses_kg;
+    if !info.dimension.is_two() {
+        // Per grain: position, velocity, spin, force, three components each.
+        let state = |r: &[f64]| {
+            let at = |k: usize, q: usize| Vec3::new(r[1 + 12 * k + 3 * q], r[2 + 12 * k + 3 * q], r[3 + 12 * k + 3 * q]);
+            let (x0, v0, w0) = (at(0, 0), at(0, 1), at(0, 2));
+            let (x1, v1, w1) = (at(j, 0), at(j, 1), at(j, 2));
+            ImpactState::<Space> {
+                time: r[0] * info.time_step_s,
+                x: [x0, x1],
+                v: [v0, v1],
+                omega: [w0, w1],
+                r: [info.radii_m[0], info.radii_m[j]],
+                f0: at(0, 3),
+                wall: info.flat_wall.map(|[y, side, vx]| (y, side, Vec3::new(vx, 0.0, 0.0))),
+                boundary: Boundary::open(),
+                momentum: if two { v0 * m[0] + v1 * m[1] } else { v0 * m[0] },
+                momentum_scale: m[0] * v0.norm() + if two { m[1] * v1.norm() } else { 0.0 },
+            }
+        };
+        return observe_series(path, &rows, state);
+    }
     let state = |r: &[f64]| {
         let g = |k: usize| (Vec2::new(r[1 + 7 * k], r[2 + 7 * k]), Vec2::new(r[3 + 7 * k], r[4 + 7 * k]), r[5 + 7 * k]);
         let (x0, v0, w0) = g(0);
         let (x1, v1, w1) = g(j);
-        let m = &info.masses_kg;
         let momentum = if two { m[0] * v0 + m[1] * v1 } else { m[0] * v0 };
         let scale = m[0] * v0.norm() + if two { m[1] * v1.norm() } else { 0.0 };
-        ImpactState {
+        ImpactState::<Plane> {
             time: r[0] * info.time_step_s,
             x: [x0, x1],
             v: [v0, v1],
@@ -139,7 +165,12 @@ pub fn impact_of_series(info: &ExportInfo, path: &Path) -> Result<(ImpactObserve
             momentum_scale: scale,
         }
     };
-    let mut obs = ImpactObserver::default();
+    observe_series(path, &rows, state)
+}
+
+/// The impact observer over the rows of `path`, each read into a state by `state`.
+fn observe_series<D: Impacts>(path: &Path, rows: &[Vec<f64>], state: impl Fn(&[f64]) -> ImpactState<D>) -> Result<(Vec<CurvePoint>, ImpactSummary), Error> {
+    let mut obs = ImpactObserver::<D>::default();
     let mut it = rows.iter();
     let first = it.next().ok_or_else(|| Error::Other(format!("{}: no rows", path.display())))?;
     obs.start_state(&state(first));
@@ -147,5 +178,5 @@ pub fn impact_of_series(info: &ExportInfo, path: &Path) -> Result<(ImpactObserve
         obs.observe_state(&state(r));
     }
     let s = obs.summary().ok_or_else(|| Error::Other(format!("{}: the grains did not touch and separate", path.display())))?;
-    Ok((obs, s))
+    Ok((obs.curve, s))
 }
