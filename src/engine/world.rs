@@ -232,7 +232,7 @@ impl<L: ContactLaw> World<L> {
 
 /// Numbers as `[a, b]` (or `[a, b, c]`), each [`Shown`].
 fn shown_components(c: &[f64]) -> String {
-    format!("[{}]", c.iter().map(|c| c.shown()).collect::<Vec<_>>().join(", "))
+    format!("[{}]", crate::error::shown_joined(c))
 }
 
 /// A change of the walls' motion and control and of gravity between two steps: what a

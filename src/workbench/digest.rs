@@ -122,54 +122,52 @@ pub fn impact_of_series(info: &ExportInfo, path: &Path) -> Result<(Vec<CurvePoin
     if header != info.columns {
         return Err(Error::Other(format!("{}: columns {:?}, expected {:?}", path.display(), header, info.columns)));
     }
+    if info.dimension.is_two() {
+        // Per grain: x, y, vx, vy, the spin about z, fx, fy.
+        return observe_series::<Plane>(info, path, &rows, |r, k| {
+            let c = &r[1 + 7 * k..];
+            (Vec2::new(c[0], c[1]), Vec2::new(c[2], c[3]), c[4], Vec2::new(c[5], c[6]))
+        });
+    }
+    // Per grain: position, velocity, spin, force, three components each.
+    observe_series::<Space>(info, path, &rows, |r, k| {
+        let at = |q: usize| Vec3::from_column_slice(&r[1 + 12 * k + 3 * q..4 + 12 * k + 3 * q]);
+        (at(0), at(1), at(2), at(3))
+    })
+}
+
+/// The impact observer over the rows of `path`: `grain(row, k)` reads grain k's
+/// position, velocity, spin and force from a row.
+fn observe_series<D: Impacts>(
+    info: &ExportInfo,
+    path: &Path,
+    rows: &[Vec<f64>],
+    grain: impl Fn(&[f64], usize) -> (D::Vector<f64>, D::Vector<f64>, D::Spin<f64>, D::Vector<f64>),
+) -> Result<(Vec<CurvePoint>, ImpactSummary), Error> {
     let two = info.radii_m.len() == 2;
     let j = if two { 1 } else { 0 };
     let m = &info.masses_kg;
-    if !info.dimension.is_two() {
-        // Per grain: position, velocity, spin, force, three components each.
-        let state = |r: &[f64]| {
-            let at = |k: usize, q: usize| Vec3::new(r[1 + 12 * k + 3 * q], r[2 + 12 * k + 3 * q], r[3 + 12 * k + 3 * q]);
-            let (x0, v0, w0) = (at(0, 0), at(0, 1), at(0, 2));
-            let (x1, v1, w1) = (at(j, 0), at(j, 1), at(j, 2));
-            ImpactState::<Space> {
-                time: r[0] * info.time_step_s,
-                x: [x0, x1],
-                v: [v0, v1],
-                omega: [w0, w1],
-                r: [info.radii_m[0], info.radii_m[j]],
-                f0: at(0, 3),
-                wall: info.flat_wall.map(|[y, side, vx]| (y, side, Vec3::new(vx, 0.0, 0.0))),
-                boundary: Boundary::open(),
-                momentum: if two { v0 * m[0] + v1 * m[1] } else { v0 * m[0] },
-                momentum_scale: m[0] * v0.norm() + if two { m[1] * v1.norm() } else { 0.0 },
-            }
-        };
-        return observe_series(path, &rows, state);
-    }
     let state = |r: &[f64]| {
-        let g = |k: usize| (Vec2::new(r[1 + 7 * k], r[2 + 7 * k]), Vec2::new(r[3 + 7 * k], r[4 + 7 * k]), r[5 + 7 * k]);
-        let (x0, v0, w0) = g(0);
-        let (x1, v1, w1) = g(j);
-        let momentum = if two { m[0] * v0 + m[1] * v1 } else { m[0] * v0 };
-        let scale = m[0] * v0.norm() + if two { m[1] * v1.norm() } else { 0.0 };
-        ImpactState::<Plane> {
+        let (x0, v0, w0, f0) = grain(r, 0);
+        let (x1, v1, w1, _) = grain(r, j);
+        ImpactState::<D> {
             time: r[0] * info.time_step_s,
             x: [x0, x1],
             v: [v0, v1],
             omega: [w0, w1],
             r: [info.radii_m[0], info.radii_m[j]],
-            f0: Vec2::new(r[6], r[7]),
-            wall: info.flat_wall.map(|[y, side, vx]| (y, side, Vec2::new(vx, 0.0))),
+            f0,
+            // A flat wall moves along x only (ExportInfo::flat_wall).
+            wall: info.flat_wall.map(|[y, side, vx]| {
+                let mut v = D::zero();
+                v[0] = vx;
+                (y, side, v)
+            }),
             boundary: Boundary::open(),
-            momentum,
-            momentum_scale: scale,
+            momentum: if two { v0 * m[0] + v1 * m[1] } else { v0 * m[0] },
+            momentum_scale: m[0] * D::norm(v0) + if two { m[1] * D::norm(v1) } else { 0.0 },
         }
     };
-    observe_series(path, &rows, state)
-}
-
-/// The impact observer over the rows of `path`, each read into a state by `state`.
-fn observe_series<D: Impacts>(path: &Path, rows: &[Vec<f64>], state: impl Fn(&[f64]) -> ImpactState<D>) -> Result<(Vec<CurvePoint>, ImpactSummary), Error> {
     let mut obs = ImpactObserver::<D>::default();
     let mut it = rows.iter();
     let first = it.next().ok_or_else(|| Error::Other(format!("{}: no rows", path.display())))?;

@@ -326,8 +326,9 @@ fn stages<D: Dim>(scene: &Scene, ex: &Exported<D>, shear_run: &str) -> Result<St
     // The plain run's script, its record() ending with the stage changes and its O.run
     // replaced by the stages' (each piece found once: a template edited out of step with
     // this fails every protocol export's test, not silently).
-    let reset = if D::D == 3 { "        for k in range(6):\n            acc[k] = 0.0\n" } else { "        for k in range(4):\n            acc[k] = 0.0\n" };
-    let run = edited(shear_run, reset, &format!("{reset}    while NEXT[0] < len(STAGES) and STAGES[NEXT[0]][1] == O.iter:\n        begin(STAGES[NEXT[0]])\n"));
+    // The two walls' accumulated force components ([`shear_run`]).
+    let reset = format!("        for k in range({}):\n            acc[k] = 0.0\n", 2 * D::D);
+    let run = edited(shear_run, &reset, &format!("{reset}    while NEXT[0] < len(STAGES) and STAGES[NEXT[0]][1] == O.iter:\n        begin(STAGES[NEXT[0]])\n"));
     let run = edited(
         &run,
         "O.run(STEPS, True)\n",
