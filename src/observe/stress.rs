@@ -5,8 +5,9 @@
 //! the mean grain diameter for spheres in the plane; `walls.thickness` overrides).
 //! Shear stress tau = (F_bottom,x - F_top,x) / (2 L_x t), normal stress
 //! sigma = (F_top,y - F_bottom,y) / (2 L_x t), both positive in a sheared, compressed cell.
-//! In space t is the cell's length along z, so the stresses are F / (L_x L_z); the walls'
-//! z forces (friction across the shear) are not in the rows yet.
+//! In space t is the cell's length along z, so the stresses are F / (L_x L_z); the rows
+//! carry the walls' z forces too (friction across the shear, zero on average in a cell
+//! periodic in z), which the plane's rows leave out.
 //! Their ratio is undefined (written as an empty cell, `null` in JSON) while sigma is zero,
 //! e.g. before any grain touches a wall.
 
@@ -25,6 +26,12 @@ pub struct WallRow {
     pub bottom_fy_n: f64,
     pub top_fx_n: f64,
     pub top_fy_n: f64,
+    /// In space only: the z forces on the bottom and top walls, N (absent in the plane's
+    /// rows, so a 2D walls.csv keeps its columns).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bottom_fz_n: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub top_fz_n: Option<f64>,
     pub gap_m: f64,
     pub shear_stress_pa: f64,
     pub normal_stress_pa: f64,
@@ -36,6 +43,8 @@ pub struct WallRow {
 #[derive(Debug, Default, Serialize, Deserialize)]
 pub struct WallAverager {
     sum: [Vec2; 2],
+    /// The z forces' sums (in space; zero in the plane).
+    sum_z: [f64; 2],
     n: u64,
 }
 
@@ -45,6 +54,10 @@ impl WallAverager {
         if w.len() == 2 {
             self.sum[0] += Vec2::new(w[0].force[0], w[0].force[1]);
             self.sum[1] += Vec2::new(w[1].force[0], w[1].force[1]);
+            if D::D == 3 {
+                self.sum_z[0] += w[0].force[2];
+                self.sum_z[1] += w[1].force[2];
+            }
             self.n += 1;
         }
     }
@@ -55,8 +68,10 @@ impl WallAverager {
             return None;
         }
         let (b, t) = (self.sum[0] / self.n as f64, self.sum[1] / self.n as f64);
+        let z = self.sum_z.map(|f| f / self.n as f64);
         *self = WallAverager::default();
-        Some(WallRow::new(e.time, b, t, w[1].y - w[0].y, length, depth))
+        let row = WallRow::new(e.time, b, t, w[1].y - w[0].y, length, depth);
+        Some(if D::D == 3 { row.with_z(z) } else { row })
     }
 }
 
@@ -79,11 +94,17 @@ impl WallRow {
             bottom_fy_n: b.y,
             top_fx_n: t.x,
             top_fy_n: t.y,
+            bottom_fz_n: None,
+            top_fz_n: None,
             gap_m,
             shear_stress_pa: tau,
             normal_stress_pa: sigma,
             stress_ratio: ratio(tau, sigma),
         }
+    }
+    /// The row in space: the z forces on the bottom and top walls, N.
+    pub fn with_z(self, [bottom, top]: [f64; 2]) -> WallRow {
+        WallRow { bottom_fz_n: Some(bottom), top_fz_n: Some(top), ..self }
     }
 }
 

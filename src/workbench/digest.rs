@@ -51,17 +51,21 @@ pub fn digest(case_dir: &Path, code: Code, run_dir: &Path) -> Result<PathBuf, Er
             }
         }
         Analysis::Shear => {
-            let (_, rows) = read_table(&run_dir.join("walls.txt"))?;
-            // In space the rows carry the walls' z forces too (wall_columns_in); the
-            // stresses are of the x and y forces, as grainlab's walls.csv.
-            let rows: Vec<Vec<f64>> = if info.dimension.is_two() { rows } else { rows.iter().map(|r| [0, 1, 2, 4, 5, 7].map(|k| r[k]).to_vec()).collect() };
+            let walls = run_dir.join("walls.txt");
+            let (header, rows) = read_table(&walls)?;
+            // Each row: the step, the bottom and top walls' forces (x, y and in space z),
+            // the gap.
+            let d = if info.dimension.is_two() { 2 } else { 3 };
+            if header.len() != 2 * d + 2 {
+                return Err(Error::Other(format!("{}: {} columns, a {d}D deck writes {}", walls.display(), header.len(), 2 * d + 2)));
+            }
             let series = if info.stages.is_empty() {
-                rows.iter().map(|r| WallRow::new(r[0] * info.time_step_s, Vec2::new(r[1], r[2]), Vec2::new(r[3], r[4]), r[5], info.length_m, info.depth_m)).collect()
+                rows.iter().map(|r| wall_row(&info, r[0] * info.time_step_s, &r[1..=d], &r[1 + d..=2 * d], r[2 * d + 1])).collect()
             } else {
-                protocol_rows(&info, &rows).map_err(|e| Error::Other(format!("{}: {e}", run_dir.join("walls.txt").display())))?
+                protocol_rows(&info, &rows, d).map_err(|e| Error::Other(format!("{}: {e}", walls.display())))?
             };
             if series.len() < 4 {
-                return Err(Error::Other(format!("{}: fewer than 4 rows", run_dir.join("walls.txt").display())));
+                return Err(Error::Other(format!("{}: fewer than 4 rows", walls.display())));
             }
             let mut w = CsvSeries::create(&out.join("stress.csv"))?;
             for r in &series {
@@ -73,7 +77,7 @@ pub fn digest(case_dir: &Path, code: Code, run_dir: &Path) -> Result<PathBuf, Er
                 None => series.clone(),
             };
             if averaged.len() < 4 {
-                return Err(Error::Other(format!("{}: fewer than 4 rows in the averaged stage", run_dir.join("walls.txt").display())));
+                return Err(Error::Other(format!("{}: fewer than 4 rows in the averaged stage", walls.display())));
             }
             std::fs::write(out.join("shear.json"), serde_json::to_string_pretty(&stress_estimates(&averaged, None, &info.statistics)).expect("serialisable") + "\n")
                 .map_err(|e| Error::io(out.display(), e))?;
@@ -83,11 +87,18 @@ pub fn digest(case_dir: &Path, code: Code, run_dir: &Path) -> Result<PathBuf, Er
     Ok(out)
 }
 
+/// A wall row at `time` from the bottom (`b`) and top (`t`) walls' forces, N (x, y and
+/// in space z), and the gap, m.
+fn wall_row(info: &ExportInfo, time: f64, b: &[f64], t: &[f64], gap: f64) -> WallRow {
+    let row = WallRow::new(time, Vec2::new(b[0], b[1]), Vec2::new(t[0], t[1]), gap, info.length_m, info.depth_m);
+    if b.len() == 3 { row.with_z([b[2], t[2]]) } else { row }
+}
+
 /// A protocol's rows as grainlab writes them, from a deck's row of every step (step,
-/// forces on the bottom and top walls, gap): in each stage a row every `sample_every` of
-/// its steps and at its last, the forces averaged over the row's steps, the gap at its
-/// last, as [`crate::observe::stress::WallAverager`] does.
-fn protocol_rows(info: &ExportInfo, rows: &[Vec<f64>]) -> Result<Vec<WallRow>, String> {
+/// the `d` force components on the bottom and top walls, gap): in each stage a row every
+/// `sample_every` of its steps and at its last, the forces averaged over the row's steps,
+/// the gap at its last, as [`crate::observe::stress::WallAverager`] does.
+fn protocol_rows(info: &ExportInfo, rows: &[Vec<f64>], d: usize) -> Result<Vec<WallRow>, String> {
     let total: u64 = info.stages.iter().map(|st| st.steps).sum();
     if rows.len() as u64 != total {
         return Err(format!("{} rows, but a protocol's deck records each of its {total} steps", rows.len()));
@@ -95,7 +106,7 @@ fn protocol_rows(info: &ExportInfo, rows: &[Vec<f64>]) -> Result<Vec<WallRow>, S
     let mut out = Vec::new();
     let mut k = 0;
     for st in &info.stages {
-        let (mut sum, mut n) = ([Vec2::zeros(); 2], 0u32);
+        let (mut sum, mut n) = ([[0.0; 3]; 2], 0u32);
         for j in 1..=st.steps {
             let r = &rows[k];
             k += 1;
@@ -103,13 +114,17 @@ fn protocol_rows(info: &ExportInfo, rows: &[Vec<f64>]) -> Result<Vec<WallRow>, S
             if r[0] != step as f64 {
                 return Err(format!("row {k} is step {}, expected step {step}", r[0]));
             }
-            sum[0] += Vec2::new(r[1], r[2]);
-            sum[1] += Vec2::new(r[3], r[4]);
+            for (wall, s) in sum.iter_mut().enumerate() {
+                for (c, s) in s.iter_mut().take(d).enumerate() {
+                    *s += r[1 + wall * d + c];
+                }
+            }
             n += 1;
             if j % st.sample_every == 0 || j == st.steps {
                 let time = step as f64 * info.time_step_s;
-                out.push(WallRow::new(time, sum[0] / n as f64, sum[1] / n as f64, r[5], info.length_m, info.depth_m));
-                (sum, n) = ([Vec2::zeros(); 2], 0);
+                let [b, t] = sum.map(|s| s.map(|f| f / n as f64));
+                out.push(wall_row(info, time, &b[..d], &t[..d], r[2 * d + 1]));
+                (sum, n) = ([[0.0; 3]; 2], 0);
             }
         }
     }
