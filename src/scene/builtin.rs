@@ -180,13 +180,21 @@ pub fn shear() -> Scene {
 /// rough walls (square lattices of glued 0.5 mm spheres) at -+0.5 m/s, the top one under
 /// 100 kPa on its 10 x 10 mm area; the 2D cell's model and time step.
 pub fn shear3d() -> Scene {
-    let (l, v, p) = (0.01, 0.5, 1e5);
+    shear_box(2000, 0.01)
+}
+
+/// The 3D shear box ([`shear3d`]) with `count` spheres in a square cell `length` m on a
+/// side (periodic in x and z): the same height when `count` grows with `length` squared
+/// (2000 spheres per 10 x 10 mm), as the workbench's 3D ensembles and
+/// `scripts/bench-peers` size it.
+pub fn shear_box(count: usize, length: f64) -> Scene {
+    let (l, v, p) = (length, 0.5, 1e5);
     let mut s = shear();
     s.name = "shear3d".into();
     s.description = BUILTIN[4].1.into();
     s.dimension = Dimension::Three;
     s.domain = Domain { periodic_x: Some([0.0, l]), periodic_z: Some([0.0, l]) };
-    s.grains = Grains::Pack(PackSpec { count: 2000, radius: RadiusDist::Uniform { min: 0.4e-3, max: 0.6e-3 }, seed: 1, material: 0, x: [0.0, l], z: Some([0.0, l]), y_min: None, packing_fraction: 0.5 });
+    s.grains = Grains::Pack(PackSpec { count, radius: RadiusDist::Uniform { min: 0.4e-3, max: 0.6e-3 }, seed: 1, material: 0, x: [0.0, l], z: Some([0.0, l]), y_min: None, packing_fraction: 0.5 });
     let walls = s.walls.as_mut().expect("the shear cell has walls");
     (walls.bottom.velocity_x, walls.top.velocity_x, walls.top.control) = (-v, v, ControlSpec::Pressure(p));
     s.duration = 0.02;
