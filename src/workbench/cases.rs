@@ -137,22 +137,7 @@ pub fn cases() -> Vec<Case> {
     // over ENSEMBLE_SEEDS packings, each code with its own formulation, as the single
     // runs above.
     for (code, tag) in [(Code::Liggghts, "liggghts"), (Code::Yade, "yade")] {
-        let group = format!("shear-ensemble/{tag}");
-        for seed in ENSEMBLE_SEEDS {
-            let mut s = builtin::shear_cell(200, 0.008);
-            if let crate::scene::Grains::Pack(p) = &mut s.grains {
-                p.seed = seed;
-            }
-            if code == Code::Liggghts {
-                s.model.lever_arm = LeverArm::RadiusMinusHalfOverlap;
-            } else {
-                matched(&mut s, TangentialSpec::IncrementalForce);
-            }
-            s.output.frames = 0;
-            let name = format!("{group}/seed-{seed}");
-            s.description = format!("the shear cell with 200 grains (0.008 m periodic), packing seed {seed}, with {}'s settings: one member of {group}", code.name());
-            out.push(Case::new(name, s, vec![code], false).in_ensemble(group.clone()));
-        }
+        ensemble(&mut out, &format!("shear-ensemble/{tag}"), code, || builtin::shear_cell(200, 0.008), "the shear cell with 200 grains (0.008 m periodic)");
     }
     space_shear_cases(&mut out);
     out
@@ -168,21 +153,27 @@ pub fn cases() -> Vec<Case> {
 /// so the 3D shear box is compared as ensembles only.
 fn space_shear_cases(out: &mut Vec<Case>) {
     for (code, tag) in [(Code::Liggghts, "liggghts"), (Code::Yade, "yade")] {
-        let group = format!("space-shear-ensemble/{tag}");
-        for seed in ENSEMBLE_SEEDS {
-            let mut s = builtin::shear_box(200, 0.005);
-            if let crate::scene::Grains::Pack(p) = &mut s.grains {
-                p.seed = seed;
-            }
-            if code == Code::Liggghts {
-                s.model.lever_arm = LeverArm::RadiusMinusHalfOverlap;
-            } else {
-                matched(&mut s, TangentialSpec::IncrementalForce);
-            }
-            s.output.frames = 0;
-            s.description = format!("the 3D shear box with 200 spheres (5 x 5 mm, periodic in x and z), packing seed {seed}, with {}'s settings: one member of {group}", code.name());
-            out.push(Case::new(format!("{group}/seed-{seed}"), s, vec![code], false).in_ensemble(group.clone()));
+        ensemble(out, &format!("space-shear-ensemble/{tag}"), code, || builtin::shear_box(200, 0.005), "the 3D shear box with 200 spheres (5 x 5 mm, periodic in x and z)");
+    }
+}
+
+/// An ensemble's members, `group/seed-K`: `scene()` with each of [`ENSEMBLE_SEEDS`] as its
+/// packing's seed and `code`'s settings (LIGGGHTS' lever arm; YADE's incremental force,
+/// kinematics and clamp), `what` the scene in its description.
+fn ensemble(out: &mut Vec<Case>, group: &str, code: Code, scene: impl Fn() -> Scene, what: &str) {
+    for seed in ENSEMBLE_SEEDS {
+        let mut s = scene();
+        if let crate::scene::Grains::Pack(p) = &mut s.grains {
+            p.seed = seed;
         }
+        if code == Code::Liggghts {
+            s.model.lever_arm = LeverArm::RadiusMinusHalfOverlap;
+        } else {
+            matched(&mut s, TangentialSpec::IncrementalForce);
+        }
+        s.output.frames = 0;
+        s.description = format!("{what}, packing seed {seed}, with {}'s settings: one member of {group}", code.name());
+        out.push(Case::new(format!("{group}/seed-{seed}"), s, vec![code], false).in_ensemble(group.to_string()));
     }
 }
 
