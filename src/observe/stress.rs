@@ -19,7 +19,9 @@ use crate::scene::StatisticsSpec;
 use crate::physics::dim::{Dim, Vec2};
 
 /// One row of the wall time series (forces averaged over the sample interval).
-#[derive(Clone, Copy, Debug, Default, Serialize, serde::Deserialize)]
+/// Serialised by hand (below): a text format (walls.csv) leaves the plane's absent z
+/// forces out, a binary one (the checkpoint, which is read by position) keeps every field.
+#[derive(Clone, Copy, Debug, Default, serde::Deserialize)]
 pub struct WallRow {
     pub time_s: f64,
     pub bottom_fx_n: f64,
@@ -28,15 +30,41 @@ pub struct WallRow {
     pub top_fy_n: f64,
     /// In space only: the z forces on the bottom and top walls, N (absent in the plane's
     /// rows, so a 2D walls.csv keeps its columns).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(default)]
     pub bottom_fz_n: Option<f64>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(default)]
     pub top_fz_n: Option<f64>,
     pub gap_m: f64,
     pub shear_stress_pa: f64,
     pub normal_stress_pa: f64,
     /// tau/sigma; undefined (an empty cell) while the normal stress is zero.
     pub stress_ratio: Option<f64>,
+}
+
+impl Serialize for WallRow {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeStruct;
+        // In text the plane's rows have no z columns; in binary every field, in order.
+        let z = self.bottom_fz_n.is_some() || self.top_fz_n.is_some() || !s.is_human_readable();
+        let mut st = s.serialize_struct("WallRow", if z { 11 } else { 9 })?;
+        st.serialize_field("time_s", &self.time_s)?;
+        st.serialize_field("bottom_fx_n", &self.bottom_fx_n)?;
+        st.serialize_field("bottom_fy_n", &self.bottom_fy_n)?;
+        st.serialize_field("top_fx_n", &self.top_fx_n)?;
+        st.serialize_field("top_fy_n", &self.top_fy_n)?;
+        if z {
+            st.serialize_field("bottom_fz_n", &self.bottom_fz_n)?;
+            st.serialize_field("top_fz_n", &self.top_fz_n)?;
+        } else {
+            st.skip_field("bottom_fz_n")?;
+            st.skip_field("top_fz_n")?;
+        }
+        st.serialize_field("gap_m", &self.gap_m)?;
+        st.serialize_field("shear_stress_pa", &self.shear_stress_pa)?;
+        st.serialize_field("normal_stress_pa", &self.normal_stress_pa)?;
+        st.serialize_field("stress_ratio", &self.stress_ratio)?;
+        st.end()
+    }
 }
 
 /// Averages the wall forces over every step of a sample interval.
@@ -173,6 +201,29 @@ pub fn stress_estimates(rows: &[WallRow], packing_fraction: Option<f64>, statist
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A plane row and a space row come back from the checkpoint's binary form field for
+    /// field (postcard reads by position: a skipped field would shift every later one),
+    /// and in CSV the plane's row has no z columns, the space row both.
+    #[test]
+    fn rows_keep_every_field_in_binary_and_the_plane_s_columns_in_text() {
+        let plane = WallRow::new(1e-3, Vec2::new(1.0, -2.0), Vec2::new(-1.5, 2.5), 0.01, 0.04, 1e-3);
+        let space = plane.with_z([0.25, -0.125]);
+        for row in [plane, space] {
+            let back: WallRow = postcard::from_bytes(&postcard::to_stdvec(&(row, 7u8)).unwrap()).map(|(r, k): (WallRow, u8)| {
+                assert_eq!(k, 7, "the byte after the row");
+                r
+            }).unwrap();
+            assert_eq!(format!("{back:?}"), format!("{row:?}"));
+        }
+        let header = |row: WallRow| {
+            let mut w = csv::Writer::from_writer(Vec::new());
+            w.serialize(row).unwrap();
+            String::from_utf8(w.into_inner().unwrap()).unwrap().lines().next().unwrap().to_string()
+        };
+        assert_eq!(header(plane), "time_s,bottom_fx_n,bottom_fy_n,top_fx_n,top_fy_n,gap_m,shear_stress_pa,normal_stress_pa,stress_ratio");
+        assert_eq!(header(space), "time_s,bottom_fx_n,bottom_fy_n,top_fx_n,top_fy_n,bottom_fz_n,top_fz_n,gap_m,shear_stress_pa,normal_stress_pa,stress_ratio");
+    }
 
     /// Rows of a given tau/sigma series (sigma 1e5 Pa, tau = ratio x sigma), 1 ms apart.
     fn rows(ratio: impl Iterator<Item = f64>) -> Vec<WallRow> {
