@@ -67,39 +67,51 @@ impl Serialize for WallRow {
     }
 }
 
-/// Averages the wall forces over every step of a sample interval.
+/// Averages the wall forces over every step of a sample interval: the run loop's walls
+/// ([`WallAverager::accumulate`], [`WallAverager::row`]) and a reference code's rows of
+/// every step (the digest's protocols, [`WallAverager::add`], [`WallAverager::take`]).
 #[derive(Debug, Default, Serialize, Deserialize)]
 pub struct WallAverager {
-    sum: [Vec2; 2],
-    /// The z forces' sums (in space; zero in the plane).
-    sum_z: [f64; 2],
+    /// The bottom and top walls' force sums, N: x, y and in space z (zero in the plane).
+    sum: [[f64; 3]; 2],
     n: u64,
 }
 
 impl WallAverager {
+    /// Add one step's forces of the grains on the bottom (`b`) and top (`t`) walls, N:
+    /// x, y and in space z.
+    pub fn add(&mut self, b: &[f64], t: &[f64]) {
+        for (sum, f) in self.sum.iter_mut().zip([b, t]) {
+            sum.iter_mut().zip(f).for_each(|(s, f)| *s += f);
+        }
+        self.n += 1;
+    }
+    /// The row of the steps added since the last row, at `time` (s) with the gap (m), of
+    /// `d` force components (2 in the plane, 3 in space); restarts the averages. None if
+    /// no step was added.
+    pub fn take(&mut self, d: usize, time: f64, gap: f64, length: f64, depth: f64) -> Option<WallRow> {
+        if self.n == 0 {
+            return None;
+        }
+        let [b, t] = self.sum.map(|s| s.map(|f| f / self.n as f64));
+        *self = WallAverager::default();
+        Some(WallRow::of_forces(time, &b[..d], &t[..d], gap, length, depth))
+    }
+    /// Add the step's forces on the cell's two walls (none without them).
     pub fn accumulate<D: Dim>(&mut self, e: &View<D>) {
         let w = e.walls;
         if w.len() == 2 {
-            self.sum[0] += Vec2::new(w[0].force[0], w[0].force[1]);
-            self.sum[1] += Vec2::new(w[1].force[0], w[1].force[1]);
-            if D::D == 3 {
-                self.sum_z[0] += w[0].force[2];
-                self.sum_z[1] += w[1].force[2];
-            }
-            self.n += 1;
+            let f = |k: usize| std::array::from_fn::<f64, 3, _>(|c| if c < D::D { w[k].force[c] } else { 0.0 });
+            self.add(&f(0), &f(1));
         }
     }
     /// The row for the interval just finished; restarts the averages.
     pub fn row<D: Dim>(&mut self, e: &View<D>, length: f64, depth: f64) -> Option<WallRow> {
         let w = e.walls;
-        if w.len() != 2 || self.n == 0 {
+        if w.len() != 2 {
             return None;
         }
-        let (b, t) = (self.sum[0] / self.n as f64, self.sum[1] / self.n as f64);
-        let z = self.sum_z.map(|f| f / self.n as f64);
-        *self = WallAverager::default();
-        let row = WallRow::new(e.time, b, t, w[1].y - w[0].y, length, depth);
-        Some(if D::D == 3 { row.with_z(z) } else { row })
+        self.take(D::D, e.time, w[1].y - w[0].y, length, depth)
     }
 }
 
@@ -133,6 +145,12 @@ impl WallRow {
     /// The row in space: the z forces on the bottom and top walls, N.
     pub fn with_z(self, [bottom, top]: [f64; 2]) -> WallRow {
         WallRow { bottom_fz_n: Some(bottom), top_fz_n: Some(top), ..self }
+    }
+    /// A row from the bottom (`b`) and top (`t`) walls' forces, N: x and y in the plane,
+    /// x, y and z in space; the gap, the cell length and depth as [`WallRow::new`].
+    pub fn of_forces(time_s: f64, b: &[f64], t: &[f64], gap_m: f64, length: f64, depth: f64) -> WallRow {
+        let row = WallRow::new(time_s, Vec2::new(b[0], b[1]), Vec2::new(t[0], t[1]), gap_m, length, depth);
+        if b.len() == 3 { row.with_z([b[2], t[2]]) } else { row }
     }
 }
 

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use crate::error::Error;
 use crate::observe::impact::{CurvePoint, ImpactObserver, ImpactState, ImpactSummary, Impacts};
-use crate::observe::stress::{WallRow, stress_estimates};
+use crate::observe::stress::{WallAverager, WallRow, stress_estimates};
 use crate::output::csv::CsvSeries;
 use crate::physics::boundary::Boundary;
 use crate::physics::dim::{Plane, Space, Vec2};
@@ -60,7 +60,7 @@ pub fn digest(case_dir: &Path, code: Code, run_dir: &Path) -> Result<PathBuf, Er
                 return Err(Error::Other(format!("{}: {} columns, a {d}D deck writes {}", walls.display(), header.len(), 2 * d + 2)));
             }
             let series = if info.stages.is_empty() {
-                rows.iter().map(|r| wall_row(&info, r[0] * info.time_step_s, &r[1..=d], &r[1 + d..=2 * d], r[2 * d + 1])).collect()
+                rows.iter().map(|r| WallRow::of_forces(r[0] * info.time_step_s, &r[1..=d], &r[1 + d..=2 * d], r[2 * d + 1], info.length_m, info.depth_m)).collect()
             } else {
                 protocol_rows(&info, &rows, d).map_err(|e| Error::Other(format!("{}: {e}", walls.display())))?
             };
@@ -87,17 +87,10 @@ pub fn digest(case_dir: &Path, code: Code, run_dir: &Path) -> Result<PathBuf, Er
     Ok(out)
 }
 
-/// A wall row at `time` from the bottom (`b`) and top (`t`) walls' forces, N (x, y and
-/// in space z), and the gap, m.
-fn wall_row(info: &ExportInfo, time: f64, b: &[f64], t: &[f64], gap: f64) -> WallRow {
-    let row = WallRow::new(time, Vec2::new(b[0], b[1]), Vec2::new(t[0], t[1]), gap, info.length_m, info.depth_m);
-    if b.len() == 3 { row.with_z([b[2], t[2]]) } else { row }
-}
-
 /// A protocol's rows as grainlab writes them, from a deck's row of every step (step,
 /// the `d` force components on the bottom and top walls, gap): in each stage a row every
 /// `sample_every` of its steps and at its last, the forces averaged over the row's steps,
-/// the gap at its last, as [`crate::observe::stress::WallAverager`] does.
+/// the gap at its last: the run loop's [`WallAverager`].
 fn protocol_rows(info: &ExportInfo, rows: &[Vec<f64>], d: usize) -> Result<Vec<WallRow>, String> {
     let total: u64 = info.stages.iter().map(|st| st.steps).sum();
     if rows.len() as u64 != total {
@@ -106,7 +99,7 @@ fn protocol_rows(info: &ExportInfo, rows: &[Vec<f64>], d: usize) -> Result<Vec<W
     let mut out = Vec::new();
     let mut k = 0;
     for st in &info.stages {
-        let (mut sum, mut n) = ([[0.0; 3]; 2], 0u32);
+        let mut avg = WallAverager::default();
         for j in 1..=st.steps {
             let r = &rows[k];
             k += 1;
@@ -114,17 +107,9 @@ fn protocol_rows(info: &ExportInfo, rows: &[Vec<f64>], d: usize) -> Result<Vec<W
             if r[0] != step as f64 {
                 return Err(format!("row {k} is step {}, expected step {step}", r[0]));
             }
-            for (wall, s) in sum.iter_mut().enumerate() {
-                for (c, s) in s.iter_mut().take(d).enumerate() {
-                    *s += r[1 + wall * d + c];
-                }
-            }
-            n += 1;
+            avg.add(&r[1..=d], &r[1 + d..=2 * d]);
             if j % st.sample_every == 0 || j == st.steps {
-                let time = step as f64 * info.time_step_s;
-                let [b, t] = sum.map(|s| s.map(|f| f / n as f64));
-                out.push(wall_row(info, time, &b[..d], &t[..d], r[2 * d + 1]));
-                (sum, n) = ([[0.0; 3]; 2], 0);
+                out.extend(avg.take(d, step as f64 * info.time_step_s, r[2 * d + 1], info.length_m, info.depth_m));
             }
         }
     }
