@@ -325,7 +325,7 @@ where
     };
     match (&scene.grains, &file) {
         (Grains::List(list), _) => consistency::given_coordinates(list.iter().map(|g| (g.x.as_slice(), g.r)), |k| format!("grains.list[{k}]"))?,
-        (Grains::File { path, .. }, Some((grains, lines))) => consistency::given_coordinates(grains.iter().map(|(x, r)| (x.as_slice(), *r)), |k| format!("the grain on line {} of {path}", lines[k]))?,
+        (Grains::File { path, .. }, Some((grains, lines))) => consistency::given_coordinates(grains.iter().map(|(x, r)| (&x[..D::D], *r)), |k| format!("the grain on line {} of {path}", lines[k]))?,
         _ => {}
     }
     // The x length the rough walls span: the periodic cell, the packing's region, or the
@@ -335,7 +335,7 @@ where
         length = match (&scene.grains, &file) {
             (Grains::Pack(spec), _) => spec.x[1] - spec.x[0],
             (Grains::List(list), _) => extent(list.iter().map(|g| (g.x[0], g.r))),
-            (_, Some((grains, _))) => extent(grains.iter().map(|(x, r)| (x.x, *r))),
+            (_, Some((grains, _))) => extent(grains.iter().map(|(x, r)| (x[0], *r))),
             _ => 0.0,
         };
     }
@@ -376,7 +376,9 @@ where
             let (grains, lines) = file.expect("read above");
             for (x, r) in grains {
                 let mut at = D::zero::<f64>();
-                (at[0], at[1]) = (x.x, x.y);
+                for (k, c) in x.iter().take(D::D).enumerate() {
+                    at[k] = *c;
+                }
                 push(&mut p, at, D::zero(), D::spin_zero(), r, *material);
             }
             if let GrainNames::File(_, l) = &mut names {

@@ -3,15 +3,17 @@
 //! step is for), known before anything is built.
 
 use crate::error::Error;
-use crate::physics::dim::Vec2;
 use crate::scene::limits::Limits;
 use crate::scene::{GrainColumns, Grains, Scene};
 
+/// A grain file's grains (centre `[x, y, z]` with z = 0 for `"x y r"`, radius) and the
+/// line of each.
+type FileGrains = (Vec<([f64; 3], f64)>, Vec<u32>);
+
 /// The grains of a particle file: one per line in the declared `columns`, `#` starts a
 /// comment; with the line of each grain, for messages. The file is read up to the
-/// budget's file size ([`Limits::file_bytes`]).
-/// A grain file's grains (centre, radius) and the line of each.
-type FileGrains = (Vec<(Vec2, f64)>, Vec<u32>);
+/// budget's file size ([`Limits::file_bytes`]). A plane scene takes x and y of each
+/// centre, a 3D scene all three (it refuses `"x y r"`: [`Scene::validate`]).
 
 pub fn read_grain_file(path: &str, columns: GrainColumns, limits: &Limits) -> Result<FileGrains, Error> {
     let text = crate::scene::limits::read_bounded(std::path::Path::new(path), limits.file_bytes(), "grains.file.path")?;
@@ -27,14 +29,20 @@ pub fn read_grain_file(path: &str, columns: GrainColumns, limits: &Limits) -> Re
         if v.len() != columns.count() {
             return Err(bad(&format!("{} numbers where the columns are {}", v.len(), columns.count())));
         }
-        let (x, y, r) = (v[0], v[1], v[columns.count() - 1]);
+        let r = v[columns.count() - 1];
+        let x = match columns {
+            GrainColumns::XYR => [v[0], v[1], 0.0],
+            GrainColumns::XYZR => [v[0], v[1], v[2]],
+        };
         if !(r.is_finite() && r > 0.0) {
             return Err(bad("the radius must be > 0"));
         }
-        if !(x.is_finite() && y.is_finite()) {
+        // z is checked here too: a plane scene ignores it, but a number that is not one
+        // is a broken file.
+        if !x.iter().all(|c| c.is_finite()) {
             return Err(bad("the position must be finite"));
         }
-        out.push((Vec2::new(x, y), r));
+        out.push((x, r));
         lines.push((k + 1) as u32);
     }
     if out.is_empty() {

@@ -183,8 +183,9 @@ pub enum GrainColumns {
     #[default]
     #[serde(rename = "x y r")]
     XYR,
-    /// Centre x, y, z and radius, m; z is read and ignored (a LAMMPS-style 3D file of a
-    /// monolayer).
+    /// Centre x, y, z and radius, m: in a 3D scene the sphere's centre; in a plane
+    /// scene z is read and ignored (a LAMMPS-style 3D file of a monolayer). The columns
+    /// a 3D scene's file needs.
     #[serde(rename = "x y z r")]
     XYZR,
 }

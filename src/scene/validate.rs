@@ -79,7 +79,7 @@ impl Scene {
                     check(a.is_finite() && b.is_finite() && finite_pos(b - a), "domain", "periodic_z", format!("[{a}, {b}]"), "finite z_min < z_max")?;
                 }
                 match &self.grains {
-                    Grains::File { path, .. } => not_yet("grains.file", "path", &path, "grains.list or grains.pack")?,
+                    Grains::File { columns, .. } => check(*columns == GrainColumns::XYZR, "grains.file", "columns", format!("\"{}\"", columns.name()), "\"x y z r\" in a 3D scene (each sphere's centre needs its z)")?,
                     Grains::Pack(p) => {
                         let Some([a, b]) = p.z else { return check(false, "grains.pack", "z", "none", "[z_min, z_max] of the packing region in a 3D scene, m") };
                         check(a.is_finite() && b.is_finite() && finite_pos(b - a), "grains.pack", "z", format!("[{a}, {b}]"), "finite z_min < z_max")?;
