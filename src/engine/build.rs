@@ -375,11 +375,7 @@ where
         Grains::File { material, .. } => {
             let (grains, lines) = file.expect("read above");
             for (x, r) in grains {
-                let mut at = D::zero::<f64>();
-                for (k, c) in x.iter().take(D::D).enumerate() {
-                    at[k] = *c;
-                }
-                push(&mut p, at, D::zero(), D::spin_zero(), r, *material);
+                push(&mut p, crate::scene::Coords::from(x).lift::<D>(), D::zero(), D::spin_zero(), r, *material);
             }
             if let GrainNames::File(_, l) = &mut names {
                 *l = lines;
